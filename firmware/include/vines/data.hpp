@@ -1,0 +1,81 @@
+// The mutable data block of a run: state, running maxima, energy ledger and
+// counters. Preallocated by the caller (static or stack), reset by init().
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "vines/model.hpp"
+
+namespace vines {
+
+// Where the particle is with respect to the walls.
+enum class Mode : std::uint8_t {
+  kFree,
+  kContactLeft,   // finite-duration contact with the left wall
+  kContactRight,
+  kStuckLeft,     // instantaneous law: riding the wall at zero relative speed
+  kStuckRight,
+};
+
+// Energy ledger [J], accumulated in double whatever the loop's scalar.
+struct Ledger {
+  double input = 0;       // work of the inertial loads -m a_g on every mass
+  double damping = 0;     // dissipated by the frame's (and TMD's) dashpots
+  double contact = 0;     // dissipated in contacts (rate term, or impacts)
+  double kinetic = 0;     // stored now: kinetic...
+  double strain = 0;      // ...frame strain...
+  double device = 0;      // ...TMD spring or contact elastic energy
+  double residual = 0;    // input - stored - dissipated, now
+  double max_abs_residual = 0;
+  double max_input = 0;   // largest of input and stored + dissipated so far
+  double relative_residual() const { return max_input > 0 ? max_abs_residual / max_input : 0; }
+};
+
+struct Counters {
+  std::int64_t steps = 0;
+  std::int64_t careful_steps = 0;     // steps that needed sub-stepping
+  std::int64_t substeps = 0;          // accepted sub-steps
+  std::int64_t contact_substeps = 0;  // of which in contact (or stuck)
+  std::int64_t rejected = 0;          // rejected sub-step attempts
+  std::int64_t events = 0;            // located contact starts/ends/impacts
+  std::int64_t contacts = 0;          // contacts deeper than the counting depth
+  std::int64_t cap_hits = 0;          // steps that hit the sub-step cap
+  std::int64_t max_substeps_in_step = 0;
+};
+
+template <typename S, int N, typename Dev>
+struct Data {
+  using M = Model<S, N, Dev>;
+  using VecX = typename M::VecX;
+  using VecN = typename M::VecN;
+
+  std::int64_t k = 0;  // samples consumed; the state is at t = k h
+  S a_prev = S(0);     // ground acceleration at the current time
+  VecX z;              // linear part
+
+  // VI NES particle: s = displacement from its start (relative to ground).
+  S s = S(0), sd = S(0);
+  Mode mode = Mode::kFree;
+  S substep = S(0);         // last sub-step size (carried across steps)
+  S contact_force = S(0);   // on the particle, positive to the right
+  S contact_depth = S(0);   // deepest overlap of the current contact
+  S max_overlap = S(0);     // deepest overlap of the run
+
+  // Outputs at the current time.
+  VecN x, v;
+  // Running maxima over the whole run (continuous in time, not just samples).
+  VecN peak_x, peak_drift;
+  S peak_top = S(0);
+  double t_peak_top = 0;
+  double elastic_energy = 0;  // E_e = integral of (1/2) x^T K x dt [J s]
+  double strain_increments = 0;  // sum of positive increments of the strain energy [J]
+  double last_strain = 0;
+  Ledger ledger;
+  Counters count;
+
+  double time(const M& m) const { return static_cast<double>(k) * m.h; }
+};
+
+}  // namespace vines

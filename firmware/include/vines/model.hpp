@@ -1,0 +1,282 @@
+// The immutable model: everything the loop needs, computed once from the
+// scene parameters (in double) and stored in the loop's scalar S. Layout of
+// the linear state z:
+//   no device, VI NES: modal coordinates [q1, q1', q2, q2', ...] (B = 2 blocks)
+//   TMD:               physical [x_1..x_N, x_d, v_1..v_N, v_d]     (one dense block)
+#pragma once
+
+#include <Eigen/Core>
+
+#include "vines/devices.hpp"
+#include "vines/frame.hpp"
+#include "vines/lti.hpp"
+#include "vines/params.hpp"
+#include "vines/validate.hpp"
+
+namespace vines {
+
+template <typename Dev, int N>
+struct Layout {
+  static constexpr int kNx = 2 * N, kB = 2, kP = N;  // kP: position coordinates
+};
+template <int N>
+struct Layout<TmdDevice, N> {
+  static constexpr int kNx = 2 * (N + 1), kB = 2 * (N + 1), kP = N + 1;
+};
+
+// Device constants in the loop's scalar.
+template <typename S, typename Dev>
+struct DeviceModel {};
+
+template <typename S>
+struct DeviceModel<S, TmdDevice> {
+  TmdDesign design;
+  S x0 = S(0), v0 = S(0);  // initial TMD state relative to its floor
+};
+
+template <typename S, ContactLaw L>
+struct DeviceModel<S, VinesDevice<L>> {
+  VinesDesign design;
+  S m, m_star, inv_m;
+  S wall_left, wall_right;  // in the particle coordinate s (see below)
+  S y0, v0;                 // initial position (from the box centre) and velocity
+  S c;                      // Hertz prefactor, for the stored contact energy
+  S eps;
+  // The law's kernel (unused for the instantaneous law).
+  std::conditional_t<L == ContactLaw::kTsuji, contact::Tsuji<S>,
+                     std::conditional_t<L == ContactLaw::kKuwabara, contact::Kuwabara<S>,
+                                        contact::Hertz<S>>>
+      law;
+  // Error scales of the sub-stepper: a position and a speed typical of contacts.
+  S pos_scale, vel_scale, modal_scale;
+};
+
+template <typename S, int N, typename Dev>
+struct Model {
+  static constexpr int kNx = Layout<Dev, N>::kNx;
+  static constexpr int kB = Layout<Dev, N>::kB;
+  static constexpr int kP = Layout<Dev, N>::kP;
+  using VecX = Eigen::Matrix<S, kNx, 1>;
+  using VecN = Eigen::Matrix<S, N, 1>;
+
+  // Reporting (double): the frame as simulated, its modes, the nominal modes.
+  Frame<N> frame;
+  Modal<N> modal;
+  Modal<N> nominal_modal;
+  LoopParams loop;
+  double h = 0;          // sensor period [s]
+  int floor = N - 1;     // device floor, 0-based
+  S hs = S(0);           // h in S
+
+  // Exact step and exact step integrals of the linear part.
+  Lti<S, kNx, kB> lti;
+  QuadIntegral<S, kNx, kB> strain_step;   // integral of (1/2) x^T K x: E_e
+  QuadIntegral<S, kNx, kB> input_step;    // input work of the linear part's masses
+  QuadIntegral<S, kNx, kB> damping_step;  // dashpot dissipation
+  // Instantaneous forms: energies and powers.
+  BlockForm<S, kNx, kB> kinetic, strain, device_potential, damping_power, input_power;
+
+  // Floors from z: x = pos_map * (position coordinates), likewise v.
+  Eigen::Matrix<S, N, kP> pos_map;
+  // Absolute floor acceleration: -(M^-1 K) x - (M^-1 C) v + (force on floor f) / m_f.
+  Eigen::Matrix<S, N, N> minv_k, minv_c;
+  S inv_floor_mass = S(0);
+
+  DeviceModel<S, Dev> dev;
+
+  // Position and velocity coordinates of z.
+  Eigen::Matrix<S, kP, 1> positions(const VecX& z) const {
+    if constexpr (kB == 2)
+      return Eigen::Map<const Eigen::Matrix<S, kP, 1>, 0, Eigen::InnerStride<2>>(z.data());
+    else
+      return z.template head<kP>();
+  }
+  Eigen::Matrix<S, kP, 1> velocities(const VecX& z) const {
+    if constexpr (kB == 2)
+      return Eigen::Map<const Eigen::Matrix<S, kP, 1>, 0, Eigen::InnerStride<2>>(z.data() + 1);
+    else
+      return z.template tail<kP>();
+  }
+  VecN floor_x(const VecX& z) const { return pos_map * positions(z); }
+  VecN floor_v(const VecX& z) const { return pos_map * velocities(z); }
+  S floor_x(const VecX& z, int i) const { return pos_map.row(i).dot(positions(z)); }
+  S floor_v(const VecX& z, int i) const { return pos_map.row(i).dot(velocities(z)); }
+};
+
+namespace detail {
+
+// Physical matrices over the P position coordinates: mass, frame stiffness,
+// device spring, damping (frame dashpots and the TMD's).
+template <int P>
+struct Physical {
+  Eigen::Matrix<double, P, P> m, k_frame, k_device, c;
+};
+
+template <int NX>
+Eigen::Matrix<double, NX + 1, NX + 1> zz_form(const Eigen::Matrix<double, NX, NX>& q) {
+  Eigen::Matrix<double, NX + 1, NX + 1> out = Eigen::Matrix<double, NX + 1, NX + 1>::Zero();
+  out.template topLeftCorner<NX, NX>() = q;
+  return out;
+}
+
+}  // namespace detail
+
+// Builds the model in place (it can be large: keep it static). Returns the
+// first problem found; the model is usable only when the result is ok().
+template <typename S, int N, typename Dev>
+ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
+  using M = Model<S, N, Dev>;
+  constexpr int NX = M::kNx, B = M::kB, P = M::kP;
+  Model<S, N, Dev>& md = *out;
+
+  ParamError err = validate(p);
+  if (!err.ok()) return err;
+  if (p.frame.stories != N) return {"frame.stories", "does not match the compiled frame size"};
+  if (p.device.kind != Dev::kKind) return {"device.kind", "does not match the compiled device"};
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    if (p.device.vines.law != Dev::kLaw)
+      return {"vines.law", "does not match the compiled contact law"};
+  }
+
+  // Frame as simulated (damage applied) and nominal (devices are designed on it).
+  md.frame = build_frame<N>(p.frame);
+  md.modal = modal_analysis(md.frame);
+  FrameParams nominal = p.frame;
+  nominal.stiffness_scale = 1.0;
+  md.nominal_modal = modal_analysis(build_frame<N>(nominal));
+  md.loop = p.loop;
+  md.h = 1.0 / p.loop.sensor_rate_hz;
+  md.hs = static_cast<S>(md.h);
+  md.floor = p.device.floor > 0 ? p.device.floor - 1 : N - 1;
+  const double device_mass = p.device.mass_kg > 0.0
+                                 ? p.device.mass_kg
+                                 : p.device.mass_ratio * md.nominal_modal.m_eff(0);
+  const double floor_mass = md.frame.m(md.floor);
+
+  // Classical damping is what makes the modal blocks exact: check it.
+  if constexpr (B == 2) {
+    const Eigen::Matrix<double, N, N> cm = md.modal.phi.transpose() * md.frame.C * md.modal.phi;
+    const double diag = cm.diagonal().cwiseAbs().maxCoeff();
+    if ((cm - Eigen::Matrix<double, N, N>(cm.diagonal().asDiagonal())).cwiseAbs().maxCoeff() >
+        1e-8 * (diag > 0.0 ? diag : 1.0))
+      return {"frame.damping", "is not classical (modal coordinates would not decouple)"};
+  }
+
+  // Physical matrices over the position coordinates (TMD adds one).
+  detail::Physical<P> ph;
+  ph.m.setZero();
+  ph.k_frame.setZero();
+  ph.k_device.setZero();
+  ph.c.setZero();
+  ph.m.template topLeftCorner<N, N>() = md.frame.m.asDiagonal();
+  ph.k_frame.template topLeftCorner<N, N>() = md.frame.K;
+  ph.c.template topLeftCorner<N, N>() = md.frame.C;
+
+  // Continuous-time linear part, and maps from z to positions and velocities.
+  LtiSpec<NX> spec;
+  spec.a.setZero();
+  spec.bg.setZero();
+  spec.bf.setZero();
+  Eigen::Matrix<double, P, NX> px = Eigen::Matrix<double, P, NX>::Zero(), pv = px;
+  if constexpr (Dev::kKind == DeviceKind::kTmd) {
+    const TmdDesign t = design_tmd(p.device.tmd, device_mass, md.nominal_modal.m_eff(0),
+                                   md.nominal_modal.omega(0));
+    md.dev.design = t;
+    md.dev.x0 = static_cast<S>(p.device.tmd.initial_position_m);
+    md.dev.v0 = static_cast<S>(p.device.tmd.initial_velocity_mps);
+    const int f = md.floor, d = N;
+    ph.m(d, d) = t.mass;
+    ph.k_device(f, f) = ph.k_device(d, d) = t.k;
+    ph.k_device(f, d) = ph.k_device(d, f) = -t.k;
+    ph.c(f, f) += t.c;
+    ph.c(d, d) += t.c;
+    ph.c(f, d) -= t.c;
+    ph.c(d, f) -= t.c;
+    const Eigen::Matrix<double, P, P> minv = ph.m.diagonal().cwiseInverse().asDiagonal();
+    spec.a.template topRightCorner<P, P>().setIdentity();
+    spec.a.template bottomLeftCorner<P, P>() = -minv * (ph.k_frame + ph.k_device);
+    spec.a.template bottomRightCorner<P, P>() = -minv * ph.c;
+    spec.bg.template tail<P>().setConstant(-1.0);
+    px.template leftCols<P>().setIdentity();
+    pv.template rightCols<P>().setIdentity();
+    md.pos_map.setZero();
+    md.pos_map.template leftCols<N>().setIdentity();
+  } else {
+    const Modal<N>& mo = md.modal;
+    for (int j = 0; j < N; ++j) {
+      const double w = mo.omega(j);
+      spec.a(2 * j, 2 * j + 1) = 1.0;
+      spec.a(2 * j + 1, 2 * j) = -w * w;
+      spec.a(2 * j + 1, 2 * j + 1) = -2.0 * mo.zeta(j) * w;
+      spec.bg(2 * j + 1) = -mo.gamma(j);
+      spec.bf(2 * j + 1) = mo.phi(md.floor, j);
+      px.col(2 * j) = mo.phi.col(j);
+      pv.col(2 * j + 1) = mo.phi.col(j);
+    }
+    md.pos_map = mo.phi.template cast<S>();
+  }
+  md.lti = discretise<S, NX, B>(spec, md.h);
+
+  // Energies and powers as quadratic forms in [z; a_g].
+  using QX = Eigen::Matrix<double, NX, NX>;
+  const auto q_kin = detail::zz_form<NX>(QX(0.5 * pv.transpose() * ph.m * pv));
+  const auto q_strain = detail::zz_form<NX>(QX(0.5 * px.transpose() * ph.k_frame * px));
+  const auto q_devpot = detail::zz_form<NX>(QX(0.5 * px.transpose() * ph.k_device * px));
+  const auto q_damp = detail::zz_form<NX>(QX(pv.transpose() * ph.c * pv));
+  // Input power -a_g (sum of m v) as a bilinear form: off-diagonal halves.
+  Eigen::Matrix<double, NX + 1, NX + 1> q_in = Eigen::Matrix<double, NX + 1, NX + 1>::Zero();
+  const Eigen::Matrix<double, NX, 1> mv = pv.transpose() * ph.m.diagonal();
+  q_in.template block<NX, 1>(0, NX) = -0.5 * mv;
+  q_in.template block<1, NX>(NX, 0) = -0.5 * mv.transpose();
+
+  md.kinetic = block_form<S, NX, B>(q_kin);
+  md.strain = block_form<S, NX, B>(q_strain);
+  md.device_potential = block_form<S, NX, B>(q_devpot);
+  md.damping_power = block_form<S, NX, B>(q_damp);
+  md.input_power = block_form<S, NX, B>(q_in);
+  md.strain_step = quad_integral<S, NX, B>(spec, q_strain, md.h);
+  if (p.loop.energy_ledger) {
+    md.input_step = quad_integral<S, NX, B>(spec, q_in, md.h);
+    md.damping_step = quad_integral<S, NX, B>(spec, q_damp, md.h);
+  }
+
+  const Eigen::Matrix<double, N, 1> minv_frame = md.frame.m.cwiseInverse();
+  md.minv_k = (minv_frame.asDiagonal() * md.frame.K).template cast<S>();
+  md.minv_c = (minv_frame.asDiagonal() * md.frame.C).template cast<S>();
+  md.inv_floor_mass = static_cast<S>(1.0 / floor_mass);
+
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    const VinesParams& vp = p.device.vines;
+    const VinesDesign d = design_vines(vp, device_mass, floor_mass);
+    if (!d.ok) return {"vines.eps", "tau could not be calibrated for this eps and v_ref"};
+    if (!(d.gap > 0.0)) return {"vines.box_length_m", "must be longer than the sphere diameter"};
+    const double y0 = vp.start_at_left_wall ? -d.gap : vp.initial_position_m;
+    if (std::fabs(y0) > d.gap)
+      return {"vines.initial_position_m", "must lie within the free travel (-gap, +gap)"};
+    auto& dm = md.dev;
+    dm.design = d;
+    dm.m = static_cast<S>(d.mass);
+    dm.inv_m = static_cast<S>(1.0 / d.mass);
+    dm.m_star = static_cast<S>(d.m_star);
+    // The particle is carried as s = y - y0, its displacement (relative to the
+    // ground) from where it starts; the walls are at r = s - x_floor equal to
+    // -gap - y0 and gap - y0. Starting on the left wall, that wall is at 0
+    // exactly: no cancellation fakes sub-nanometre contacts.
+    dm.wall_left = static_cast<S>(-d.gap - y0);
+    dm.wall_right = static_cast<S>(d.gap - y0);
+    dm.y0 = static_cast<S>(y0);
+    dm.v0 = static_cast<S>(vp.initial_velocity_mps);
+    dm.c = static_cast<S>(d.c);
+    dm.eps = static_cast<S>(d.eps);
+    dm.law.c = static_cast<S>(d.c);
+    if constexpr (Dev::kLaw == ContactLaw::kTsuji || Dev::kLaw == ContactLaw::kKuwabara)
+      dm.law.g = static_cast<S>(d.g);
+    const double v_scale = vp.v_ref_mps > 0.0 ? vp.v_ref_mps : 0.5;
+    dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));
+    dm.vel_scale = static_cast<S>(v_scale);
+    dm.modal_scale = static_cast<S>(std::sqrt(md.frame.m.sum()));
+  }
+  return {};
+}
+
+}  // namespace vines

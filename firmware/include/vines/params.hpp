@@ -1,0 +1,105 @@
+// Scene parameters: the plain data a scene file (or a configure message on a
+// link) turns into. Everything is SI and double; the model builder checks it
+// and turns it into an immutable Model<S, N, Device>. No heap, no pointers.
+#pragma once
+
+#include <cstdint>
+
+namespace vines {
+
+// Capacity of the parameter arrays; a frame's actual story count is a
+// compile-time N <= kMaxStories chosen by the caller.
+inline constexpr int kMaxStories = 40;
+
+// g used for every g <-> m/s^2 conversion (MODEL.md).
+inline constexpr double kGravity = 9.80665;
+
+enum class DampingRule : std::uint8_t {
+  kStiffnessProportional,  // C = c_k * K (the paper: c_k = 0.0129 s)
+  kRayleigh,               // C = a0 M + a1 K, fitted to two modal ratios
+  kModal,                  // the same ratio zeta on every mode
+};
+
+struct FrameParams {
+  int stories = 10;
+  double mass_kg[kMaxStories] = {};
+  double stiffness_n_per_m[kMaxStories] = {};
+  DampingRule damping = DampingRule::kStiffnessProportional;
+  double stiffness_damping_s = 0.0129;      // kStiffnessProportional
+  double rayleigh_zeta[2] = {0.02, 0.02};  // kRayleigh: target ratios...
+  int rayleigh_modes[2] = {1, 2};          // ...on these modes (1-based)
+  double modal_zeta = 0.02;                // kModal
+  // Damage: every story stiffness is scaled by eta_k. Damping is built from the
+  // scaled K (C = c_k K stays proportional to what the frame really has).
+  double stiffness_scale = 1.0;
+};
+
+enum class DeviceKind : std::uint8_t { kNone, kTmd, kVines };
+
+enum class ContactLaw : std::uint8_t {
+  kHertz,        // F = C d^{3/2}
+  kTsuji,        // + D(eps) sqrt(C m*) d^{1/4} d'
+  kKuwabara,     // + (3/2) C tau d^{1/2} d'
+  kRestitution,  // instantaneous, Newton's law with eps
+};
+
+struct TmdParams {
+  // Den Hartog design (Eq. 18) from the mass ratio on the nominal frame's
+  // first mode, unless k and c are given (> 0).
+  double k_n_per_m = 0.0;
+  double c_ns_per_m = 0.0;
+  double initial_position_m = 0.0;  // relative to its floor
+  double initial_velocity_mps = 0.0;
+};
+
+struct VinesParams {
+  // Sphere: mass comes from DeviceParams (mass ratio or mass); radius from
+  // mass and density unless radius_m > 0 (then the mass follows from it).
+  double radius_m = 0.0;
+  double density_kg_m3 = 8000.0;
+  double young_pa = 210e9;
+  double poisson = 0.3;
+  double wall_young_pa = 210e9;
+  double wall_poisson = 0.3;
+  // Box: length b = beta * 2R unless box_length_m > 0.
+  double beta = 1.35;
+  double box_length_m = 0.0;
+  ContactLaw law = ContactLaw::kKuwabara;
+  double eps = 0.7;       // restitution target (Tsuji, Kuwabara, Restitution)
+  double v_ref_mps = 0.5; // Kuwabara: tau calibrated at this impact speed...
+  double tau_s = 0.0;     // ...unless tau is given (> 0)
+  // Initial particle state relative to the box centre. The default puts the
+  // particle at rest against the left wall (u = -gap).
+  bool start_at_left_wall = true;
+  double initial_position_m = 0.0;
+  double initial_velocity_mps = 0.0;
+};
+
+struct DeviceParams {
+  DeviceKind kind = DeviceKind::kNone;
+  int floor = 0;  // 1-based floor the device sits on; 0 means the top floor
+  // Device mass: mass_kg if > 0, else mass_ratio times the first-mode
+  // effective mass of the nominal (undamaged) frame.
+  double mass_ratio = 0.05;
+  double mass_kg = 0.0;
+  TmdParams tmd;
+  VinesParams vines;
+};
+
+struct LoopParams {
+  double sensor_rate_hz = 1000.0;
+  // Contact sub-stepping (adaptive embedded Runge-Kutta inside a step).
+  double contact_rtol = 1e-10;
+  int max_substeps_per_step = 4096;
+  // Contacts shallower than this are not counted (rounding at rest contact).
+  double contact_count_depth_m = 1e-9;
+  bool energy_ledger = true;
+};
+
+struct SceneParams {
+  FrameParams frame;
+  DeviceParams device;
+  LoopParams loop;
+};
+
+}  // namespace vines

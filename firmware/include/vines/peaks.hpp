@@ -1,0 +1,58 @@
+// Running maxima of the response over a step, continuous in time: the peak
+// inside a step is placed from the values and derivatives at its two ends.
+#pragma once
+
+#include <cmath>
+
+#include "vines/data.hpp"
+#include "vines/model.hpp"
+#include "vines/numeric/hermite.hpp"
+
+namespace vines {
+
+namespace detail {
+
+// Running maxima over one step of |x| per floor and per story drift, from the
+// values and velocities at both ends (cubic Hermite inside the step). Only
+// steps that can beat the current maximum are refined.
+template <typename S, int N>
+void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>& v0,
+                  const Eigen::Matrix<S, N, 1>& x1, const Eigen::Matrix<S, N, 1>& v1, S h,
+                  Eigen::Matrix<S, N, 1>& peak_x, Eigen::Matrix<S, N, 1>& peak_drift) {
+  auto refine = [h](S y0, S d0, S y1, S d1, S& peak) {
+    const S ends = std::fabs(y0) > std::fabs(y1) ? std::fabs(y0) : std::fabs(y1);
+    if (ends + S(0.5) * h * (std::fabs(d0) + std::fabs(d1)) <= peak) return;
+    const auto c = numeric::Cubic<S>::make(y0, d0, y1, d1, h);
+    const auto cn = numeric::Cubic<S>::make(-y0, -d0, -y1, -d1, h);
+    const S a = c.max_value(), b = cn.max_value();
+    const S m = a > b ? a : b;
+    if (m > peak) peak = m;
+  };
+  for (int i = 0; i < N; ++i) {
+    refine(x0(i), v0(i), x1(i), v1(i), peak_x(i));
+    const S dx0 = i ? x0(i) - x0(i - 1) : x0(i), dx1 = i ? x1(i) - x1(i - 1) : x1(i);
+    const S dv0 = i ? v0(i) - v0(i - 1) : v0(i), dv1 = i ? v1(i) - v1(i - 1) : v1(i);
+    refine(dx0, dv0, dx1, dv1, peak_drift(i));
+  }
+}
+
+// Peak of the top floor over an exact step: quintic Hermite with the
+// accelerations at both ends (error ~h^6), for a converged peak at any rate.
+template <typename S, int N, typename Dev>
+void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
+                     const typename Model<S, N, Dev>::VecX& z0, S a0, S x0, S v0, S a1) {
+  const S x1 = d.x(N - 1), v1 = d.v(N - 1);
+  const S bound = std::fmax(std::fabs(x0), std::fabs(x1)) +
+                  S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
+  if (bound <= d.peak_top) return;
+  const S acc0 = m.floor_v(m.lti.derivative(z0, a0, S(0)), N - 1);
+  const S acc1 = m.floor_v(m.lti.derivative(d.z, a1, S(0)), N - 1);
+  const S p = numeric::quintic_abs_max(x0, v0, acc0, x1, v1, acc1, m.hs);
+  if (p > d.peak_top) {
+    d.peak_top = p;
+    d.t_peak_top = d.time(m) + m.h;
+  }
+}
+
+}  // namespace detail
+}  // namespace vines

@@ -1,0 +1,405 @@
+// VI NES stage of the loop: the particle between the walls.
+//   - free_flight: exact step of the particle under -a_g alone;
+//   - needs_substeps: whether the particle touches, or may touch, a wall
+//     within the coming step (then the exact step is not used);
+//   - substep_through: adaptive Dormand-Prince sub-steps over the step with
+//     the frame in modal coordinates, contact starts and ends located to
+//     rounding (the contact force is not smooth there), impacts of the
+//     instantaneous law applied at their instant, a cap on sub-steps.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "vines/data.hpp"
+#include "vines/model.hpp"
+#include "vines/numeric/dopri5.hpp"
+#include "vines/numeric/hermite.hpp"
+#include "vines/peaks.hpp"
+
+namespace vines {
+
+// Below this approach speed [m/s] an instantaneous impact is taken as plastic
+// and the particle rides the wall (no Zeno cascade of ever smaller bounces).
+inline constexpr double kStickSpeed = 1e-6;
+
+// Overlap with the left and right walls for a relative position r = s - x_f
+// (positive means interpenetration).
+template <typename S, typename DM>
+S overlap_left(const DM& dm, S r) { return dm.wall_left - r; }
+template <typename S, typename DM>
+S overlap_right(const DM& dm, S r) { return r - dm.wall_right; }
+
+// Elastic energy stored in the current contact, (2/5) C d^{5/2}.
+template <typename S, int N, typename Dev>
+S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+  if (d.mode != Mode::kContactLeft && d.mode != Mode::kContactRight) return S(0);
+  const S r = d.s - m.floor_x(d.z, m.floor);
+  const S dl = d.mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
+  return dl > S(0) ? S(0.4) * m.dev.c * dl * dl * std::sqrt(dl) : S(0);
+}
+
+// Exact free flight of the particle over one step (acceleration -a_g, linear),
+// with the work of its inertial load.
+template <typename S, int N, typename Dev>
+void free_flight(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
+  const S h = m.hs, al = (a1 - a0) / h, v0 = d.sd;
+  if (m.loop.energy_ledger) {
+    // -m integral of a(t) v(t) dt, a = a0 + al t, v = v0 - a0 t - al t^2 / 2.
+    const S h2 = h * h, h3 = h2 * h, h4 = h3 * h;
+    const S w = a0 * v0 * h - a0 * a0 * h2 / S(2) - a0 * al * h3 / S(6) + al * v0 * h2 / S(2) -
+                al * a0 * h3 / S(3) - al * al * h4 / S(8);
+    d.ledger.input -= static_cast<double>(m.dev.m * w);
+  }
+  d.s += v0 * h - a0 * h * h / S(2) - al * h * h * h / S(6);
+  d.sd = v0 - a0 * h - al * h * h / S(2);
+}
+
+// True when the coming step cannot be taken exactly: the particle is in
+// contact, or its relative position may reach a wall within the step (cubic
+// through both ends of the free step, with a margin for what a cubic misses).
+template <typename S, int N, typename Dev>
+bool needs_substeps(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S a0, S a1) {
+  if (d.mode != Mode::kFree) return true;
+  typename Model<S, N, Dev>::VecX z1 = d.z;
+  m.lti.step(z1, a0, a1);
+  const S h = m.hs, al = (a1 - a0) / h;
+  const S s1 = d.s + d.sd * h - a0 * h * h / S(2) - al * h * h * h / S(6);
+  const S sd1 = d.sd - a0 * h - al * h * h / S(2);
+  const int f = m.floor;
+  const S r0 = d.s - m.floor_x(d.z, f), rd0 = d.sd - m.floor_v(d.z, f);
+  const S r1 = s1 - m.floor_x(z1, f), rd1 = sd1 - m.floor_v(z1, f);
+  const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + S(1e-9) * (m.dev.wall_right - m.dev.wall_left);
+  const auto left = numeric::Cubic<S>::make(m.dev.wall_left - r0, -rd0, m.dev.wall_left - r1, -rd1, h);
+  const auto right = numeric::Cubic<S>::make(r0 - m.dev.wall_right, rd0, r1 - m.dev.wall_right, rd1, h);
+  return left.max_value() + margin > S(0) || right.max_value() + margin > S(0);
+}
+
+namespace detail {
+
+// State of the sub-stepper: [z; s; s'; contact loss; input; damping; E_e].
+template <typename S, int NX>
+using SubVec = Eigen::Matrix<S, NX + 6, 1>;
+
+template <typename S, int N, typename Dev>
+struct SubStepper {
+  static constexpr int NX = Model<S, N, Dev>::kNx;
+  using Vec = SubVec<S, NX>;
+  using VecX = typename Model<S, N, Dev>::VecX;
+  const Model<S, N, Dev>& m;
+  S a0, al;   // ground acceleration a0 + al t over the step
+  Mode mode;
+
+  S ag(S t) const { return a0 + al * t; }
+  S rel_pos(const Vec& y) const { return y(NX) - m.floor_x(VecX(y.template head<NX>()), m.floor); }
+  S rel_vel(const Vec& y) const { return y(NX + 1) - m.floor_v(VecX(y.template head<NX>()), m.floor); }
+
+  // Force on the particle (positive to the right) and the power lost in it.
+  void force(const Vec& y, S t, S* fp, S* loss) const {
+    *fp = S(0);
+    *loss = S(0);
+    const auto& dm = m.dev;
+    if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
+      if constexpr (Dev::kLaw != ContactLaw::kRestitution) {
+        const bool left = mode == Mode::kContactLeft;
+        const S r = rel_pos(y), rd = rel_vel(y);
+        const S dl = left ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
+        if (dl <= S(0)) return;
+        const S ddl = left ? -rd : rd;
+        const contact::Force<S> f = dm.law(dl, ddl);
+        *fp = left ? f.total() : -f.total();
+        *loss = f.dissipative * ddl;
+      }
+    } else if (mode == Mode::kStuckLeft || mode == Mode::kStuckRight) {
+      // Riding the wall: the force that gives the particle the floor's
+      // acceleration, m* (floor acceleration without the device + a_g).
+      const VecX z = y.template head<NX>();
+      const S floor_acc = m.floor_v(m.lti.derivative(z, ag(t), S(0)), m.floor);
+      *fp = dm.m_star * (floor_acc + ag(t));
+    }
+  }
+
+  Vec operator()(S t, const Vec& y) const {
+    S fp, loss;
+    force(y, t, &fp, &loss);
+    const S a = ag(t);
+    const VecX z = y.template head<NX>();
+    Vec dy;
+    dy.template head<NX>() = m.lti.derivative(z, a, -fp);
+    dy(NX) = y(NX + 1);
+    dy(NX + 1) = -a + fp * m.dev.inv_m;
+    dy(NX + 2) = loss;
+    dy(NX + 3) = m.input_power.eval(z, a) - a * m.dev.m * y(NX + 1);
+    dy(NX + 4) = m.damping_power.eval(z, a);
+    dy(NX + 5) = m.strain.eval(z, a);
+    return dy;
+  }
+
+  // Error of a sub-step relative to the scales of a contact (energies excluded).
+  S error_norm(const Vec& e, const Vec& y0, const Vec& y1, S rtol) const {
+    const auto& dm = m.dev;
+    S worst = S(0);
+    for (int i = 0; i < NX + 2; ++i) {
+      const bool modal = i < NX, vel = modal ? (i % 2 == 1) : i == NX + 1;
+      S scale = vel ? dm.vel_scale : dm.pos_scale;
+      if (modal) scale *= dm.modal_scale;
+      const S mag = std::fmax(std::fabs(y0(i)), std::fabs(y1(i)));
+      const S r = std::fabs(e(i)) / (rtol * (scale + mag));
+      if (r > worst) worst = r;
+    }
+    return worst;
+  }
+};
+
+}  // namespace detail
+
+// Bookkeeping of an accepted sub-step from y0 to y1: peaks, contact depth.
+template <typename S, int N, typename Dev, typename Vec>
+void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0,
+                   const Vec& y1, S h) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  using VecX = typename Model<S, N, Dev>::VecX;
+  const VecX z0 = y0.template head<NX>(), z1 = y1.template head<NX>();
+  const typename Model<S, N, Dev>::VecN x0 = m.floor_x(z0), v0 = m.floor_v(z0);
+  const typename Model<S, N, Dev>::VecN x1 = m.floor_x(z1), v1 = m.floor_v(z1);
+  detail::update_peaks<S, N>(x0, v0, x1, v1, h, d.peak_x, d.peak_drift);
+  if (d.peak_x(N - 1) > d.peak_top) {
+    d.peak_top = d.peak_x(N - 1);
+    d.t_peak_top = d.time(m) + static_cast<double>(h);
+  }
+  if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
+    const S r = y1(NX) - m.floor_x(z1, m.floor);
+    const S dl = mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
+    if (dl > d.contact_depth) d.contact_depth = dl;
+    if (dl > d.max_overlap) d.max_overlap = dl;
+  }
+}
+
+// What happens at a located event (side: -1 left wall, +1 right wall).
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  const auto& dm = m.dev;
+  switch (st.mode) {
+    case Mode::kFree:
+      if constexpr (Dev::kLaw == ContactLaw::kRestitution) {
+        // Newton's law between the particle and the floor mass (Eq. 4).
+        const S rd = st.rel_vel(y);
+        const S v_app = side < 0 ? -rd : rd;
+        if (v_app <= S(0)) return;
+        const bool plastic = dm.eps * v_app < static_cast<S>(kStickSpeed);
+        const S e = plastic ? S(0) : dm.eps;
+        const S j = contact::restitution_impulse(dm.m, S(1) / m.inv_floor_mass, v_app, e);
+        const S jp = side < 0 ? j : -j;  // impulse on the particle
+        y(NX + 1) += jp * dm.inv_m;
+        for (int b = 0; b < Model<S, N, Dev>::kNx / 2; ++b)
+          y.template segment<2>(2 * b) -= m.lti.bf[b] * jp;
+        y(NX + 2) += S(0.5) * dm.m_star * (S(1) - e * e) * v_app * v_app;
+        if (v_app > static_cast<S>(kStickSpeed)) ++d.count.contacts;
+        if (plastic) {
+          st.mode = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
+          S fp, loss;
+          st.force(y, S(0), &fp, &loss);
+          if ((side < 0 && fp < S(0)) || (side > 0 && fp > S(0))) st.mode = Mode::kFree;
+        }
+      } else {
+        st.mode = side < 0 ? Mode::kContactLeft : Mode::kContactRight;
+        d.contact_depth = S(0);
+      }
+      break;
+    case Mode::kContactLeft:
+    case Mode::kContactRight:
+      if (d.contact_depth > static_cast<S>(m.loop.contact_count_depth_m)) ++d.count.contacts;
+      st.mode = Mode::kFree;
+      break;
+    default:
+      st.mode = Mode::kFree;
+      break;
+  }
+}
+
+// An event due right now, before any time passes: 0 if none, else the wall
+// side (-1, +1). Contacts end once the overlap is gone; free particles start
+// a contact if they overlap a wall while approaching it; riding particles
+// leave the wall once the holding force would pull.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
+  const auto& dm = m.dev;
+  const S r = st.rel_pos(y), rd = st.rel_vel(y);
+  switch (st.mode) {
+    case Mode::kFree:
+      if (overlap_left<S>(dm, r) > S(0) && rd < S(0)) return -1;
+      if (overlap_right<S>(dm, r) > S(0) && rd > S(0)) return 1;
+      return 0;
+    case Mode::kContactLeft:
+      return overlap_left<S>(dm, r) < S(0) || (overlap_left<S>(dm, r) == S(0) && rd > S(0)) ? -1 : 0;
+    case Mode::kContactRight:
+      return overlap_right<S>(dm, r) < S(0) || (overlap_right<S>(dm, r) == S(0) && rd < S(0)) ? 1 : 0;
+    default: {
+      S fp, loss;
+      st.force(y, S(0), &fp, &loss);
+      const bool left = st.mode == Mode::kStuckLeft;
+      return (left && fp < S(0)) || (!left && fp > S(0)) ? (left ? -1 : 1) : 0;
+    }
+  }
+}
+
+// Sub-stepped step from the current state to the next sample a1.
+template <typename S, int N, typename Dev>
+void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  using Stepper = detail::SubStepper<S, N, Dev>;
+  using Vec = typename Stepper::Vec;
+  const auto& dm = m.dev;
+  const S h = m.hs;
+  // Tolerances that the scalar can honour.
+  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol),
+                           S(64) * std::numeric_limits<S>::epsilon());
+  const S event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2),
+                                S(64) * std::numeric_limits<S>::epsilon() *
+                                    (dm.wall_right - dm.wall_left));
+  const int cap = m.loop.max_substeps_per_step;
+
+  Stepper st{m, a0, (a1 - a0) / h, d.mode};
+  Vec y;
+  y.template head<NX>() = d.z;
+  y(NX) = d.s;
+  y(NX + 1) = d.sd;
+  y.template tail<4>().setZero();
+  Vec f = st(S(0), y);
+  S t = S(0);
+  S hc = d.substep > S(0) ? std::fmin(d.substep, h) : h;
+  int n = 0;
+  bool capped = false;
+  ++d.count.careful_steps;
+  // Event function of the current mode: crosses zero upwards at the event.
+  auto event_value = [&](const Vec& yy, const Vec& ff, int side, S* slope) {
+    const S r = st.rel_pos(yy);
+    const S rd = ff(NX) - m.floor_v(typename Model<S, N, Dev>::VecX(ff.template head<NX>()), m.floor);
+    switch (st.mode) {
+      case Mode::kFree:  // overlap with wall `side` becomes positive
+        *slope = side < 0 ? -rd : rd;
+        return side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
+      case Mode::kContactLeft:  // overlap returns to zero
+        *slope = rd;
+        return -overlap_left<S>(dm, r);
+      case Mode::kContactRight:
+        *slope = -rd;
+        return -overlap_right<S>(dm, r);
+      default: {  // stuck: the holding force changes sign
+        S fp, loss;
+        st.force(yy, S(0), &fp, &loss);
+        *slope = S(0);
+        return st.mode == Mode::kStuckLeft ? -fp : fp;
+      }
+    }
+  };
+
+  int immediate = 0;
+  while (t < h) {
+    // An event already due at the start of the sub-step (the state sits on
+    // the far side of a switching surface within rounding): apply it now.
+    if (immediate < 4) {
+      const int due = due_event(m, st, y);
+      if (due != 0) {
+        ++immediate;
+        ++d.count.events;
+        apply_event(m, d, st, y, due);
+        f = st(t, y);
+        continue;
+      }
+    }
+    const bool forced = n >= cap - 1;
+    const S hs = forced ? h - t : std::fmin(hc, h - t);
+    auto r = numeric::dopri5_step<Vec>(st, t, y, f, hs);
+    const S en = st.error_norm(r.err, y, r.y, rtol);
+    ++n;
+    if (!forced && !(en <= S(1))) {
+      ++d.count.rejected;
+      hc = hs * std::fmax(S(0.1), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2)));
+      continue;
+    }
+    if (forced) capped = true;
+
+    // Does an event happen inside this sub-step? Which side first?
+    S theta = S(2);
+    int side = 0;
+    for (int sd = -1; sd <= 1; sd += 2) {
+      if (st.mode != Mode::kFree && sd == 1) break;
+      S s0, s1;
+      const S g0 = event_value(y, f, sd, &s0), g1 = event_value(r.y, r.f, sd, &s1);
+      const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
+      const bool stuck = st.mode == Mode::kStuckLeft || st.mode == Mode::kStuckRight;
+      const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
+      if (!hit || g0 > S(0)) continue;
+      const S th = stuck ? g0 / (g0 - g1) : cub.first_upcrossing();
+      if (th < theta) { theta = th; side = sd; }
+    }
+
+    if (theta <= S(1)) {
+      // Place the event: Illinois iterations on the true sub-step, bracket
+      // [0, hs], starting from the cubic's estimate.
+      S lo = S(0), hi = hs, glo, ghi, slope;
+      glo = event_value(y, f, side, &slope);
+      ghi = S(1);
+      S tau = theta * hs;
+      auto rr = numeric::dopri5_step<Vec>(st, t, y, f, tau);
+      int last = 0;
+      for (int it = 0; it < 40; ++it) {
+        const S g = event_value(rr.y, rr.f, side, &slope);
+        if (std::fabs(g) <= event_tol && g >= S(0)) break;
+        if (g > S(0)) { hi = tau; ghi = g; if (last == 1) glo *= S(0.5); last = 1; }
+        else { lo = tau; glo = g; if (last == -1) ghi *= S(0.5); last = -1; }
+        if (hi - lo <= S(4) * std::numeric_limits<S>::epsilon() * (t + hi)) { tau = hi; }
+        else {
+          tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
+          if (!(tau > lo && tau < hi)) tau = S(0.5) * (lo + hi);
+        }
+        rr = numeric::dopri5_step<Vec>(st, t, y, f, tau);
+        if (tau == hi && hi - lo <= S(4) * std::numeric_limits<S>::epsilon() * (t + hi)) break;
+      }
+      // Accept up to the event.
+      track_substep(m, d, st.mode, y, rr.y, tau);
+      t += tau;
+      y = rr.y;
+      ++d.count.substeps;
+      ++d.count.events;
+      if (st.mode != Mode::kFree) ++d.count.contact_substeps;
+      apply_event(m, d, st, y, side);
+      f = st(t, y);
+      continue;
+    }
+
+    // Plain accepted sub-step.
+    track_substep(m, d, st.mode, y, r.y, hs);
+    t += hs;
+    y = r.y;
+    f = r.f;
+    ++d.count.substeps;
+    if (st.mode != Mode::kFree) ++d.count.contact_substeps;
+    hc = hs * std::fmin(S(5), std::fmax(S(0.2), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2))));
+    if (t >= h * (S(1) - S(8) * std::numeric_limits<S>::epsilon())) break;
+  }
+  if (capped) ++d.count.cap_hits;
+  if (n > d.count.max_substeps_in_step) d.count.max_substeps_in_step = n;
+
+  // Write the state back.
+  d.mode = st.mode;
+  d.substep = hc;
+  d.z = y.template head<NX>();
+  d.s = y(NX);
+  d.sd = y(NX + 1);
+  d.ledger.contact += static_cast<double>(y(NX + 2));
+  d.ledger.input += static_cast<double>(y(NX + 3));
+  d.ledger.damping += static_cast<double>(y(NX + 4));
+  d.elastic_energy += static_cast<double>(y(NX + 5));
+  S fp, loss;
+  st.force(y, h, &fp, &loss);
+  d.contact_force = fp;
+  d.x = m.floor_x(d.z);
+  d.v = m.floor_v(d.z);
+}
+
+}  // namespace vines

@@ -1,0 +1,128 @@
+// Parameter checks shared by every front end (scene files on the host,
+// configure messages on a link). A scene either passes or is refused with the
+// name of the offending field and the reason; the loop never sees bad numbers.
+#pragma once
+
+#include <cmath>
+
+#include "vines/params.hpp"
+
+namespace vines {
+
+struct ParamError {
+  const char* field = nullptr;    // dotted scene key, e.g. "vines.beta"
+  const char* message = nullptr;  // what is wrong, e.g. "must be > 1"
+  int index = -1;                 // array element (0-based), -1 if none
+  bool ok() const { return field == nullptr; }
+};
+
+namespace detail {
+inline bool finite_positive(double x) { return std::isfinite(x) && x > 0.0; }
+}  // namespace detail
+
+inline ParamError validate(const FrameParams& f) {
+  using detail::finite_positive;
+  if (f.stories < 1 || f.stories > kMaxStories)
+    return {"frame.stories", "must be between 1 and 40"};
+  for (int i = 0; i < f.stories; ++i) {
+    if (!finite_positive(f.mass_kg[i])) return {"frame.masses", "must be finite and > 0", i};
+    if (!finite_positive(f.stiffness_n_per_m[i]))
+      return {"frame.stiffnesses", "must be finite and > 0", i};
+  }
+  if (!finite_positive(f.stiffness_scale) || f.stiffness_scale > 10.0)
+    return {"frame.stiffness_scale", "must be in (0, 10]"};
+  switch (f.damping) {
+    case DampingRule::kStiffnessProportional:
+      if (!std::isfinite(f.stiffness_damping_s) || f.stiffness_damping_s < 0.0)
+        return {"frame.stiffness_damping_s", "must be finite and >= 0"};
+      break;
+    case DampingRule::kRayleigh:
+      for (int j = 0; j < 2; ++j) {
+        if (!std::isfinite(f.rayleigh_zeta[j]) || f.rayleigh_zeta[j] < 0.0 ||
+            f.rayleigh_zeta[j] >= 1.0)
+          return {"frame.rayleigh_zeta", "must be in [0, 1)", j};
+        if (f.rayleigh_modes[j] < 1 || f.rayleigh_modes[j] > f.stories)
+          return {"frame.rayleigh_modes", "must name modes between 1 and the story count", j};
+      }
+      if (f.rayleigh_modes[0] == f.rayleigh_modes[1])
+        return {"frame.rayleigh_modes", "must name two different modes"};
+      break;
+    case DampingRule::kModal:
+      if (!std::isfinite(f.modal_zeta) || f.modal_zeta < 0.0 || f.modal_zeta >= 1.0)
+        return {"frame.modal_zeta", "must be in [0, 1)"};
+      break;
+  }
+  return {};
+}
+
+inline ParamError validate(const DeviceParams& d, int stories) {
+  using detail::finite_positive;
+  if (d.kind == DeviceKind::kNone) return {};
+  if (d.floor < 0 || d.floor > stories)
+    return {"device.floor", "must be between 1 and the story count (0 = top)"};
+  if (d.mass_kg != 0.0 && !finite_positive(d.mass_kg)) return {"device.mass_kg", "must be > 0"};
+  if (d.mass_kg == 0.0 && (!finite_positive(d.mass_ratio) || d.mass_ratio > 1.0))
+    return {"device.mass_ratio", "must be in (0, 1]"};
+  if (d.kind == DeviceKind::kTmd) {
+    const TmdParams& t = d.tmd;
+    const bool given_k = t.k_n_per_m != 0.0, given_c = t.c_ns_per_m != 0.0;
+    if (given_k && !finite_positive(t.k_n_per_m)) return {"tmd.k_n_per_m", "must be > 0"};
+    if (given_c && (!std::isfinite(t.c_ns_per_m) || t.c_ns_per_m < 0.0))
+      return {"tmd.c_ns_per_m", "must be >= 0"};
+    if (given_c && !given_k) return {"tmd.c_ns_per_m", "needs tmd.k_n_per_m as well"};
+    if (!std::isfinite(t.initial_position_m)) return {"tmd.initial_position_m", "must be finite"};
+    if (!std::isfinite(t.initial_velocity_mps))
+      return {"tmd.initial_velocity_mps", "must be finite"};
+    return {};
+  }
+  const VinesParams& v = d.vines;
+  if (v.radius_m != 0.0 && !finite_positive(v.radius_m)) return {"vines.radius_m", "must be > 0"};
+  if (!finite_positive(v.density_kg_m3)) return {"vines.density_kg_m3", "must be > 0"};
+  if (!finite_positive(v.young_pa)) return {"vines.young_pa", "must be > 0"};
+  if (!finite_positive(v.wall_young_pa)) return {"vines.wall_young_pa", "must be > 0"};
+  if (!(v.poisson > -1.0 && v.poisson < 0.5)) return {"vines.poisson", "must be in (-1, 0.5)"};
+  if (!(v.wall_poisson > -1.0 && v.wall_poisson < 0.5))
+    return {"vines.wall_poisson", "must be in (-1, 0.5)"};
+  if (v.box_length_m != 0.0) {
+    if (!finite_positive(v.box_length_m)) return {"vines.box_length_m", "must be > 0"};
+  } else if (!(std::isfinite(v.beta) && v.beta > 1.0)) {
+    return {"vines.beta", "must be > 1 (the box must be longer than the sphere)"};
+  }
+  if (v.law != ContactLaw::kHertz && !(std::isfinite(v.eps) && v.eps > 0.0 && v.eps <= 1.0))
+    return {"vines.eps", "must be in (0, 1]"};
+  if (v.law == ContactLaw::kKuwabara) {
+    if (v.tau_s != 0.0) {
+      if (!std::isfinite(v.tau_s) || v.tau_s < 0.0) return {"vines.tau_s", "must be >= 0"};
+    } else if (!finite_positive(v.v_ref_mps) || v.v_ref_mps > 1e3) {
+      return {"vines.v_ref_mps", "must be in (0, 1000]"};
+    }
+  }
+  if (!v.start_at_left_wall) {
+    if (!std::isfinite(v.initial_position_m)) return {"vines.initial_position_m", "must be finite"};
+  }
+  if (!std::isfinite(v.initial_velocity_mps))
+    return {"vines.initial_velocity_mps", "must be finite"};
+  return {};
+}
+
+inline ParamError validate(const LoopParams& l) {
+  if (!(std::isfinite(l.sensor_rate_hz) && l.sensor_rate_hz >= 1.0 && l.sensor_rate_hz <= 1e6))
+    return {"loop.sensor_rate_hz", "must be in [1, 1e6] Hz"};
+  if (!(std::isfinite(l.contact_rtol) && l.contact_rtol >= 1e-14 && l.contact_rtol <= 1e-2))
+    return {"loop.contact_rtol", "must be in [1e-14, 1e-2]"};
+  if (l.max_substeps_per_step < 1 || l.max_substeps_per_step > 1000000)
+    return {"loop.max_substeps_per_step", "must be in [1, 1e6]"};
+  if (!(std::isfinite(l.contact_count_depth_m) && l.contact_count_depth_m >= 0.0))
+    return {"loop.contact_count_depth_m", "must be >= 0"};
+  return {};
+}
+
+inline ParamError validate(const SceneParams& s) {
+  ParamError e = validate(s.frame);
+  if (!e.ok()) return e;
+  e = validate(s.device, s.frame.stories);
+  if (!e.ok()) return e;
+  return validate(s.loop);
+}
+
+}  // namespace vines

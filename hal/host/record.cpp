@@ -1,0 +1,373 @@
+// Host HAL backend: record files (PEER AT2, time/accel columns, accel-only),
+// resampling to the sensor rate, and the sample source with a simulated clock.
+#include "host/record.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string_view>
+
+namespace vines::hal {
+namespace {
+
+constexpr double kG = 9.80665;                    // m/s^2 per g
+constexpr std::size_t kHeaderSearchLines = 10;    // AT2 NPTS/DT line must be within these
+constexpr double kTimeTolerance = 1e-3;           // allowed time-column jitter, relative to dt
+constexpr double kKnotSnap = 1e-9;                // a knot if |u - round(u)| is below (u in dt)
+constexpr long long kMaxResampled = 100'000'000;  // refuse absurd resampling requests
+
+// ---- errors: "path:line: what" or "path: what" ----
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw RecordError(path + ": " + what);
+}
+
+[[noreturn]] void fail(const std::string& path, std::size_t line, const std::string& what) {
+  throw RecordError(path + ":" + std::to_string(line) + ": " + what);
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+// ---- reading: the file as lines, trailing whitespace and CR removed ----
+
+struct Line {
+  std::size_t number;  // 1-based
+  std::string text;
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::vector<Line> read_lines(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
+  if (ec) fail(path, "cannot access file: " + ec.message());
+  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file for reading");
+
+  std::vector<Line> lines;
+  std::string text;
+  for (std::size_t n = 1; std::getline(in, text); ++n) {
+    while (!text.empty() && is_space(text.back())) text.pop_back();
+    lines.push_back({n, std::move(text)});
+  }
+  if (in.bad()) fail(path, "read error");
+  const bool blank =
+      std::all_of(lines.begin(), lines.end(), [](const Line& l) { return l.text.empty(); });
+  if (blank) fail(path, "empty file");
+  return lines;
+}
+
+// Splits a line on whitespace; text from a '#' on is dropped when asked (column files).
+std::vector<std::string_view> tokens(std::string_view s, bool strip_comment) {
+  if (strip_comment) s = s.substr(0, s.find('#'));
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && is_space(s[i])) ++i;
+    const std::size_t start = i;
+    while (i < s.size() && !is_space(s[i])) ++i;
+    if (i > start) out.push_back(s.substr(start, i - start));
+  }
+  return out;
+}
+
+// ---- numbers: C / Fortran E, F and D formats; NaN, inf, junk refused ----
+
+double parse_number(std::string_view token, const std::string& path, std::size_t line) {
+  const std::string quoted = "'" + std::string(token) + "'";
+  std::string s(token);
+  std::replace(s.begin(), s.end(), 'D', 'E');  // Fortran double exponent: 1.0D-03
+  std::replace(s.begin(), s.end(), 'd', 'e');
+  std::size_t skip = 0;  // from_chars refuses a leading '+'
+  if (s.size() > 1 && s[0] == '+' && s[1] != '+' && s[1] != '-') skip = 1;
+
+  double v = 0.0;
+  const char* first = s.data() + skip;
+  const char* last = s.data() + s.size();
+  const auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ptr != last || ec == std::errc::invalid_argument) {
+    fail(path, line, "non-numeric token " + quoted);
+  }
+  // Out of range: underflow is a harmless tiny value, overflow is an error.
+  if (ec == std::errc::result_out_of_range) v = std::strtod(first, nullptr);
+  if (!std::isfinite(v)) fail(path, line, "non-finite value " + quoted);
+  return v;
+}
+
+// ---- PEER AT2 header: NPTS and DT on one line, units on any header line ----
+
+struct At2Header {
+  std::size_t line_index;  // index into lines of the NPTS/DT line
+  std::size_t npts;
+  double dt;
+  std::optional<Units> units;
+};
+
+std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const std::string& path) {
+  static const std::regex npts_re(R"(\bNPTS\s*=\s*(\d+))", std::regex::icase);
+  static const std::regex dt_re(R"(\bDT\s*=\s*([0-9.Ee+-]+))", std::regex::icase);
+  static const std::regex units_re(
+      R"((?:units\s+(?:are\s+|of\s+|in\s+)*\(?|\()\s*(gal|cm/s(?:ec)?|m/s(?:ec)?|g)(?![a-z]))",
+      std::regex::icase);
+  static const std::regex not_accel_re(R"(\b(velocity|displacement)\s+time\s+(series|history))",
+                                       std::regex::icase);
+
+  const std::size_t n = std::min(lines.size(), kHeaderSearchLines);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::smatch npts_m, dt_m;
+    const std::string& text = lines[i].text;
+    if (!std::regex_search(text, npts_m, npts_re) || !std::regex_search(text, dt_m, dt_re)) {
+      continue;
+    }
+    At2Header h{i, 0, 0.0, std::nullopt};
+    const std::string npts = npts_m[1].str();
+    const auto r = std::from_chars(npts.data(), npts.data() + npts.size(), h.npts);
+    if (r.ec != std::errc() || h.npts == 0) fail(path, lines[i].number, "bad NPTS '" + npts + "'");
+    h.dt = parse_number(dt_m[1].str(), path, lines[i].number);
+    if (!(h.dt > 0.0)) fail(path, lines[i].number, "DT must be positive, got " + dt_m[1].str());
+
+    // Header lines up to the NPTS line: refuse velocity/displacement files
+    // (.VT2/.DT2); units from the first line that names them.
+    for (std::size_t j = 0; j <= i; ++j) {
+      std::smatch m;
+      if (std::regex_search(lines[j].text, not_accel_re)) {
+        fail(path, lines[j].number, "not an acceleration record");
+      }
+      if (h.units || !std::regex_search(lines[j].text, m, units_re)) continue;
+      const char c0 = static_cast<char>(std::tolower(static_cast<unsigned char>(m[1].str()[0])));
+      h.units = m[1].length() == 1 ? Units::kG : c0 == 'm' ? Units::kMps2 : Units::kCmps2;
+    }
+    return h;
+  }
+  return std::nullopt;
+}
+
+// ---- parsed record before unit conversion ----
+
+struct Raw {
+  std::vector<double> values;
+  double dt = 0.0;
+  double t0 = 0.0;
+  Units units = Units::kG;
+};
+
+Raw parse_at2(const std::vector<Line>& lines, const At2Header& h, const RecordSpec& spec) {
+  Raw raw{{}, h.dt, 0.0, h.units.value_or(spec.units)};
+  raw.values.reserve(std::min<std::size_t>(h.npts, 1u << 20));
+  for (std::size_t i = h.line_index + 1; i < lines.size(); ++i) {
+    for (auto tok : tokens(lines[i].text, false)) {
+      raw.values.push_back(parse_number(tok, spec.path, lines[i].number));
+    }
+  }
+  if (raw.values.size() != h.npts) {
+    fail(spec.path, lines[h.line_index].number,
+         "NPTS=" + std::to_string(h.npts) + " in the header but " +
+             std::to_string(raw.values.size()) + " values read");
+  }
+  return raw;
+}
+
+// Acceleration values only, any count per line; dt comes from the spec.
+Raw parse_accel(const std::vector<Line>& lines, const RecordSpec& spec) {
+  if (!(spec.dt_s > 0.0) || !std::isfinite(spec.dt_s)) {
+    fail(spec.path, "accel-only record needs dt > 0, got dt = " + fmt(spec.dt_s));
+  }
+  Raw raw{{}, spec.dt_s, 0.0, spec.units};
+  for (const Line& l : lines) {
+    for (auto tok : tokens(l.text, true)) {
+      raw.values.push_back(parse_number(tok, spec.path, l.number));
+    }
+  }
+  if (raw.values.empty()) fail(spec.path, "no samples");
+  return raw;
+}
+
+// A table of numbers with the same column count on every non-comment line.
+struct Table {
+  std::vector<std::vector<double>> rows;
+  std::vector<std::size_t> line_numbers;
+  std::size_t columns = 0;
+};
+
+Table parse_table(const std::vector<Line>& lines, const std::string& path) {
+  Table t;
+  for (const Line& l : lines) {
+    const auto toks = tokens(l.text, true);
+    if (toks.empty()) continue;
+    if (t.columns == 0) t.columns = toks.size();
+    if (toks.size() != t.columns) {
+      fail(path, l.number,
+           "expected " + std::to_string(t.columns) + " columns, found " +
+               std::to_string(toks.size()));
+    }
+    std::vector<double> row;
+    row.reserve(toks.size());
+    for (auto tok : toks) row.push_back(parse_number(tok, path, l.number));
+    t.rows.push_back(std::move(row));
+    t.line_numbers.push_back(l.number);
+  }
+  if (t.rows.empty()) fail(path, "no samples");
+  return t;
+}
+
+// Time column plus acceleration columns; the time must be increasing and uniform.
+Raw parse_time_accel(const Table& t, const RecordSpec& spec) {
+  const std::string& path = spec.path;
+  if (t.columns < 2) fail(path, t.line_numbers[0], "time/accel record needs at least 2 columns");
+  if (spec.column < 1 || static_cast<std::size_t>(spec.column) >= t.columns) {
+    fail(path, t.line_numbers[0],
+         "column " + std::to_string(spec.column) + " out of range: the file has " +
+             std::to_string(t.columns - 1) + " acceleration column(s)");
+  }
+  const std::size_t n = t.rows.size();
+  if (n < 2) fail(path, t.line_numbers[0], "a time column needs at least 2 samples to give dt");
+
+  // dt from the end points; each step and each time must sit on the uniform grid.
+  const double t0 = t.rows.front()[0];
+  const double dt = (t.rows.back()[0] - t0) / static_cast<double>(n - 1);
+  const double tol = kTimeTolerance * dt;
+  for (std::size_t i = 1; i < n; ++i) {
+    const double step = t.rows[i][0] - t.rows[i - 1][0];
+    if (!(step > 0.0)) {
+      fail(
+          path, t.line_numbers[i],
+          "time does not increase (" + fmt(t.rows[i][0]) + " after " + fmt(t.rows[i - 1][0]) + ")");
+    }
+    const double grid = t0 + static_cast<double>(i) * dt;
+    if (std::abs(step - dt) > tol || std::abs(t.rows[i][0] - grid) > tol) {
+      fail(path, t.line_numbers[i],
+           "non-uniform time step " + fmt(step) + " (record dt " + fmt(dt) + ")");
+    }
+  }
+
+  Raw raw{{}, dt, t0, spec.units};
+  raw.values.reserve(n);
+  for (const auto& row : t.rows) raw.values.push_back(row[static_cast<std::size_t>(spec.column)]);
+  return raw;
+}
+
+double unit_factor(Units u) {
+  switch (u) {
+    case Units::kG: return kG;
+    case Units::kMps2: return 1.0;
+    case Units::kCmps2: return 0.01;
+  }
+  return 1.0;
+}
+
+}  // namespace
+
+// ---- load_record: pick the format, parse, convert to m/s^2 ----
+
+Record load_record(const RecordSpec& spec) {
+  if (!std::isfinite(spec.scale)) fail(spec.path, "scale must be finite");
+  const std::vector<Line> lines = read_lines(spec.path);
+
+  Raw raw;
+  const bool maybe_at2 = spec.format == RecordFormat::kAuto || spec.format == RecordFormat::kAt2;
+  const auto header = maybe_at2 ? find_at2_header(lines, spec.path) : std::nullopt;
+  if (header) {
+    raw = parse_at2(lines, *header, spec);
+  } else if (spec.format == RecordFormat::kAt2) {
+    fail(spec.path, "no 'NPTS= .., DT= ..' header line in the first " +
+                        std::to_string(kHeaderSearchLines) + " lines");
+  } else if (spec.format == RecordFormat::kAccel) {
+    raw = parse_accel(lines, spec);
+  } else {
+    // Time/accel, or (auto) a single column of accelerations.
+    const Table table = parse_table(lines, spec.path);
+    raw = (spec.format == RecordFormat::kAuto && table.columns == 1)
+              ? parse_accel(lines, spec)
+              : parse_time_accel(table, spec);
+  }
+
+  Record rec;
+  rec.path = spec.path;
+  rec.dt_s = raw.dt;
+  rec.t0_s = raw.t0;
+  const double factor = unit_factor(raw.units) * spec.scale;
+  rec.accel_mps2.reserve(raw.values.size());
+  for (double v : raw.values) rec.accel_mps2.push_back(v * factor);
+  return rec;
+}
+
+double Record::pga_mps2() const {
+  double peak = 0.0;
+  for (double a : accel_mps2) peak = std::max(peak, std::abs(a));
+  return peak;
+}
+
+// ---- resample: piecewise-linear through the knots, exact at the knots ----
+
+std::vector<double> resample(const Record& record, double rate_hz) {
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
+    fail(record.path, "resample rate must be positive, got " + fmt(rate_hz));
+  }
+  if (!(record.dt_s > 0.0) || !std::isfinite(record.dt_s) || !std::isfinite(record.t0_s)) {
+    fail(record.path, "record has no valid dt/t0");
+  }
+
+  // Knots a[0..N-1] at t0 + i dt, then a = 0 at t0 + N dt and after; 0 before t0.
+  const std::vector<double>& a = record.accel_mps2;
+  const long long n = static_cast<long long>(a.size());
+  const double end_s = record.t0_s + record.duration_s();
+  if (!(end_s * rate_hz < static_cast<double>(kMaxResampled))) {
+    fail(record.path, "resampling to " + fmt(rate_hz) + " Hz gives too many samples");
+  }
+  const long long k_last = std::max(0LL, std::llround(end_s * rate_hz));
+  auto knot = [&](long long i) { return (i >= 0 && i < n) ? a[static_cast<std::size_t>(i)] : 0.0; };
+
+  std::vector<double> out(static_cast<std::size_t>(k_last) + 1);
+  for (long long k = 0; k <= k_last; ++k) {
+    const double t = static_cast<double>(k) / rate_hz;
+    const double u = (t - record.t0_s) / record.dt_s;  // position in knot units
+    const double nearest = std::round(u);
+    double v = 0.0;
+    if (std::abs(u - nearest) <= kKnotSnap) {
+      v = knot(static_cast<long long>(nearest));  // on a knot: the sample itself, bit for bit
+    } else if (u > 0.0 && u < static_cast<double>(n)) {
+      const long long i = static_cast<long long>(std::floor(u));
+      const double frac = u - static_cast<double>(i);
+      v = knot(i) + frac * (knot(i + 1) - knot(i));
+    }
+    out[static_cast<std::size_t>(k)] = v;
+  }
+  return out;
+}
+
+// ---- RecordSource: samples in order; the clock reads round(k * 1e9 / rate) at sample k ----
+
+RecordSource::RecordSource(std::vector<double> samples_mps2, double rate_hz, SimClock* clock)
+    : samples_(std::move(samples_mps2)), rate_hz_(rate_hz), clock_(clock) {
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
+    throw std::invalid_argument("RecordSource: rate must be positive, got " + fmt(rate_hz));
+  }
+}
+
+bool RecordSource::next(double* accel_mps2) {
+  if (pos_ >= samples_.size()) return false;
+  if (clock_ != nullptr && pos_ > 0) {
+    // Advance by the difference of exact tick times so rounding never accumulates.
+    auto tick = [this](std::size_t k) {
+      return static_cast<std::uint64_t>(std::llround(static_cast<double>(k) * 1e9 / rate_hz_));
+    };
+    clock_->advance_ns(tick(pos_) - tick(pos_ - 1));
+  }
+  *accel_mps2 = samples_[pos_++];
+  return true;
+}
+
+}  // namespace vines::hal

@@ -1,0 +1,87 @@
+// Host HAL backend: ground-motion records read from files, resampled to the
+// sensor rate, and handed out one sample at a time with a simulated clock.
+// Host-only code: it may allocate and throw; the firmware never sees it.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "vines/hal/ground_source.hpp"
+
+namespace vines::hal {
+
+enum class Units { kG, kMps2, kCmps2 };
+
+enum class RecordFormat {
+  kAuto,       // PEER AT2 if the header says NPTS/DT, else columns
+  kAt2,        // PEER AT2 (legacy and NGA headers, any spacing around '=')
+  kTimeAccel,  // whitespace columns: time, then one or more acceleration columns
+  kAccel,      // acceleration values only (any count per line); needs dt
+};
+
+struct RecordSpec {
+  std::string path;
+  RecordFormat format = RecordFormat::kAuto;
+  Units units = Units::kG;  // AT2 files say their own units (g)
+  double dt_s = 0.0;        // kAccel only
+  int column = 1;           // kTimeAccel: which acceleration column (1 = first after time)
+  double scale = 1.0;       // multiplies every sample (after unit conversion)
+};
+
+// A uniformly sampled record in m/s^2: sample i is at t0_s + i * dt_s.
+struct Record {
+  std::string path;
+  double dt_s = 0.0;
+  double t0_s = 0.0;
+  std::vector<double> accel_mps2;
+  double duration_s() const { return dt_s * static_cast<double>(accel_mps2.size()); }
+  double pga_mps2() const;  // largest |a|
+};
+
+// Every problem with a record file, with a message naming the file and, where
+// it applies, the line: "path:LINE: what is wrong".
+class RecordError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads and checks a record: missing or empty file, non-numeric or non-finite
+// values, NPTS that disagrees with the values read, a non-uniform or
+// non-increasing time column, a bad dt are all RecordErrors.
+Record load_record(const RecordSpec& spec);
+
+// Samples the record's piecewise-linear acceleration at t_k = k / rate_hz for
+// k = 0 .. round(duration * rate_hz). The record is taken as zero after its
+// last sample (it ends at t0 + N dt) and before t0.
+std::vector<double> resample(const Record& record, double rate_hz);
+
+// Simulated monotonic clock: starts at 0 and advances only when told to.
+class SimClock final : public Clock {
+ public:
+  std::uint64_t now_ns() const override { return now_ns_; }
+  void advance_ns(std::uint64_t dt_ns) { now_ns_ += dt_ns; }
+
+ private:
+  std::uint64_t now_ns_ = 0;
+};
+
+// Feeds resampled samples at the sensor rate; each next() advances the clock
+// by one sensor period (the first sample is at t = 0).
+class RecordSource final : public GroundSource {
+ public:
+  RecordSource(std::vector<double> samples_mps2, double rate_hz, SimClock* clock = nullptr);
+  double rate_hz() const override { return rate_hz_; }
+  bool next(double* accel_mps2) override;
+  std::size_t size() const { return samples_.size(); }
+  std::size_t position() const { return pos_; }
+
+ private:
+  std::vector<double> samples_;
+  double rate_hz_;
+  SimClock* clock_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace vines::hal

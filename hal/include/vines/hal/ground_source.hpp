@@ -1,0 +1,35 @@
+// HAL facade: where ground-acceleration samples come from, and what time it is.
+// The firmware loop only sees these two interfaces; each build picks a backend
+// (host: record files and a simulated clock; MCU: UART and a hardware timer).
+// No virtual destructors: a deleting destructor would drag operator delete
+// (the heap) into the MCU image. Owners destroy concrete types.
+#pragma once
+
+#include <cstdint>
+
+namespace vines::hal {
+
+// Samples of ground acceleration [m/s^2] at a fixed sensor rate. Sample k is
+// the acceleration at t = k / rate_hz(), starting with k = 0 at t = 0.
+class GroundSource {
+ public:
+  virtual double rate_hz() const = 0;
+  // Writes the next sample and returns true, or returns false at the end of
+  // the stream (or on a fault the backend reports through its own status).
+  virtual bool next(double* accel_mps2) = 0;
+
+ protected:
+  ~GroundSource() = default;
+};
+
+// Monotonic time in nanoseconds. The host's simulated clock advances by one
+// sensor period per sample it hands out, so runs are reproducible.
+class Clock {
+ public:
+  virtual std::uint64_t now_ns() const = 0;
+
+ protected:
+  ~Clock() = default;
+};
+
+}  // namespace vines::hal

@@ -1,0 +1,40 @@
+# Rules shared by every bare-metal image (the smoke image here, the heap probe
+# in heap_probe/, later QEMU test images): startup code, linker script for the
+# MPS2-AN386 board, and the heap ban.
+set(VINES_MCU_DIR ${CMAKE_CURRENT_LIST_DIR})
+find_program(VINES_MCU_SIZE_TOOL arm-none-eabi-size REQUIRED)
+
+# Heap ban. Every allocator entry point of newlib and every C++ operator
+# new/delete (size_t is `unsigned int`, mangled `j`, on arm-none-eabi) is
+# wrapped: ld --wrap=SYM turns each undefined reference to SYM into one to
+# __wrap_SYM, and nothing defines __wrap_SYM. So any use of the heap, direct
+# or from inside newlib/libstdc++ (printf's stdio buffers, std::vector, ...),
+# fails the link with "undefined reference to `__wrap_malloc'" (or _Znwj...).
+# heap_probe/ proves this on every build.
+set(VINES_MCU_HEAP_SYMBOLS
+  malloc free calloc realloc reallocf memalign aligned_alloc posix_memalign valloc pvalloc
+  _malloc_r _free_r _calloc_r _realloc_r _reallocf_r _memalign_r _sbrk _sbrk_r
+  _Znwj _Znaj _ZnwjRKSt9nothrow_t _ZnajRKSt9nothrow_t
+  _ZnwjSt11align_val_t _ZnajSt11align_val_t
+  _ZnwjSt11align_val_tRKSt9nothrow_t _ZnajSt11align_val_tRKSt9nothrow_t
+  _ZdlPv _ZdaPv _ZdlPvj _ZdaPvj _ZdlPvRKSt9nothrow_t _ZdaPvRKSt9nothrow_t
+  _ZdlPvSt11align_val_t _ZdaPvSt11align_val_t _ZdlPvjSt11align_val_t _ZdaPvjSt11align_val_t
+  _ZdlPvSt11align_val_tRKSt9nothrow_t _ZdaPvSt11align_val_tRKSt9nothrow_t
+  _ZdlPvjSt11align_val_tRKSt9nothrow_t _ZdaPvjSt11align_val_tRKSt9nothrow_t)
+set(VINES_MCU_NO_HEAP_LINK_OPTIONS ${VINES_MCU_HEAP_SYMBOLS})
+list(TRANSFORM VINES_MCU_NO_HEAP_LINK_OPTIONS PREPEND "-Wl,--wrap=")
+
+# Makes `target` (an add_executable) a bootable image NAME.elf with a map file,
+# and prints its size after each link.
+function(vines_mcu_image target)
+  target_sources(${target} PRIVATE ${VINES_MCU_DIR}/startup.c)
+  target_include_directories(${target} PRIVATE ${VINES_MCU_DIR})
+  target_link_options(${target} PRIVATE
+    -nostartfiles -T${VINES_MCU_DIR}/mps2_an386.ld
+    -Wl,-Map=$<TARGET_FILE_DIR:${target}>/${target}.map
+    ${VINES_MCU_NO_HEAP_LINK_OPTIONS})
+  set_target_properties(${target} PROPERTIES
+    SUFFIX .elf LINK_DEPENDS ${VINES_MCU_DIR}/mps2_an386.ld)
+  add_custom_command(TARGET ${target} POST_BUILD
+    COMMAND ${VINES_MCU_SIZE_TOOL} $<TARGET_FILE:${target}>)
+endfunction()

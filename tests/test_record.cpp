@@ -1,0 +1,479 @@
+// Host HAL backend: record parsing (real files and hand-made good/bad files),
+// resampling, and the sample source with its simulated clock.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "host/record.hpp"
+
+namespace fs = std::filesystem;
+using namespace vines::hal;
+
+namespace {
+
+constexpr double kG = 9.80665;
+
+// ---- helpers ----
+
+// A fresh directory per test for hand-written record files.
+class RecordFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("vines_record_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Writes bytes exactly as given (CRLF stays CRLF) and returns the path.
+  std::string write(const std::string& name, const std::string& bytes) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p.string();
+  }
+
+  fs::path dir_;
+};
+
+// The RecordError message load_record throws for spec ("" and a test failure if none).
+std::string error_of(const RecordSpec& spec) {
+  try {
+    load_record(spec);
+  } catch (const RecordError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no RecordError for " << spec.path;
+  return "";
+}
+
+RecordSpec spec_for(const std::string& path, RecordFormat format = RecordFormat::kAuto) {
+  RecordSpec s;
+  s.path = path;
+  s.format = format;
+  return s;
+}
+
+// Index of the sample with the largest |a| (the first one on ties).
+std::size_t peak_index(const Record& r) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < r.accel_mps2.size(); ++i) {
+    if (std::abs(r.accel_mps2[i]) > std::abs(r.accel_mps2[best])) best = i;
+  }
+  return best;
+}
+
+std::string motions_dir() {
+#ifdef VINES_DEFAULT_GROUND_MOTIONS
+  return VINES_DEFAULT_GROUND_MOTIONS;
+#else
+  return "";
+#endif
+}
+
+// ---- real records: N, dt, t0 and the signed PGA and its sample from SOURCES.md ----
+
+struct RealCase {
+  const char* file;
+  Units units;
+  int column;
+  std::size_t n;
+  double dt;
+  double t0;
+  double pga;  // signed, in the file's units (g, or m/s^2 for Sylmar)
+  std::size_t pga_index;
+};
+
+const RealCase kRealCases[] = {
+    {"elcentro_1940_ns_peknold_dt002.at2", Units::kG, 1, 1559, 0.02, 0.0, -0.31882, 101},
+    {"elcentro_1940_ns_peer_legacy_I-ELC180_dt001.at2", Units::kG, 1, 4000, 0.01, 0.0, -0.31288,
+     215},
+    {"elcentro_1940_ns_peer_nga_west2_rsn6_I-ELC180.at2", Units::kG, 1, 5372, 0.01, 0.0, -0.28080,
+     218},
+    {"elcentro_1940_ns_2688pts_dt002_time_g.dat", Units::kG, 1, 2688, 0.02, 0.0, +0.34874, 106},
+    {"taft_1952_kern_county_TAF021_nga_west2_rsn15.at2", Units::kG, 1, 5435, 0.01, 0.0, -0.15889,
+     914},
+    {"kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2", Units::kG, 1, 7500, 0.02, 0.0, -0.83423, 426},
+    {"northridge_1994_sylmar_county_hospital_ns_time_ms2.dat", Units::kMps2, 1, 3000, 0.02, 0.0,
+     +8.2676, 210},
+    {"northridge_1994_rinaldi_228_nga_rsn1063.at2", Units::kG, 1, 1991, 0.01, 0.0, -0.87406, 256},
+    {"lomaprieta_1989_corralitos_CLS000_nga_west2_rsn753.at2", Units::kG, 1, 7997, 0.005, 0.0,
+     +0.64473, 525},
+    {"mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt", Units::kG, 1, 8171, 0.02, 0.02, +0.09953,
+     2708},
+    {"mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt", Units::kG, 2, 8171, 0.02, 0.02, +0.17117,
+     2904},
+    {"mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt", Units::kG, 3, 8171, 0.02, 0.02, -0.03734,
+     3083},
+};
+
+class RealRecords : public ::testing::TestWithParam<RealCase> {};
+
+TEST_P(RealRecords, MatchesSources) {
+  const RealCase& c = GetParam();
+  const std::string dir = motions_dir();
+  if (dir.empty() || !fs::is_directory(dir)) GTEST_SKIP() << "no ground-motion folder: " << dir;
+
+  RecordSpec spec = spec_for(dir + "/" + c.file);
+  spec.units = c.units;
+  spec.column = c.column;
+  const Record r = load_record(spec);
+
+  ASSERT_EQ(r.accel_mps2.size(), c.n);
+  EXPECT_NEAR(r.dt_s, c.dt, 1e-12);
+  EXPECT_NEAR(r.t0_s, c.t0, 1e-12);
+  const double per_unit = c.units == Units::kG ? kG : 1.0;
+  const std::size_t i = peak_index(r);
+  EXPECT_EQ(i, c.pga_index);
+  EXPECT_NEAR(r.accel_mps2[i] / per_unit, c.pga, 6e-6 * std::abs(c.pga) + 6e-6);
+  EXPECT_DOUBLE_EQ(r.pga_mps2(), std::abs(r.accel_mps2[i]));
+}
+
+INSTANTIATE_TEST_SUITE_P(Sources, RealRecords, ::testing::ValuesIn(kRealCases));
+
+// Explicit formats read the same as auto detection; scale multiplies after units.
+TEST(RealRecordFormats, ExplicitFormatAndScale) {
+  const std::string dir = motions_dir();
+  if (dir.empty() || !fs::is_directory(dir)) GTEST_SKIP() << "no ground-motion folder: " << dir;
+
+  const Record kobe = load_record(spec_for(dir + "/kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2"));
+  RecordSpec s = spec_for(dir + "/kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2", RecordFormat::kAt2);
+  s.scale = -0.5;
+  const Record half = load_record(s);
+  ASSERT_EQ(half.accel_mps2.size(), kobe.accel_mps2.size());
+  for (std::size_t i = 0; i < kobe.accel_mps2.size(); ++i) {
+    ASSERT_DOUBLE_EQ(half.accel_mps2[i], -0.5 * kobe.accel_mps2[i]);
+  }
+
+  RecordSpec t =
+      spec_for(dir + "/elcentro_1940_ns_2688pts_dt002_time_g.dat", RecordFormat::kTimeAccel);
+  EXPECT_EQ(load_record(t).accel_mps2.size(), 2688u);
+}
+
+// ---- hand-made good files: header variants, number formats, line endings ----
+
+TEST_F(RecordFiles, At2HeaderVariantsAndFortranNumbers) {
+  // NPTS on line 2, spaces around '=', CRLF, blank lines, trailing blanks, D exponents, '+'.
+  const std::string p = write("v.at2",
+                              "SOME RECORD\r\n"
+                              "NPTS =   6 , DT =   .010 SEC ,   \r\n"
+                              "\r\n"
+                              "  .1000000E+01  -.5D0  +2.5   \r\n"
+                              "  1.0d-03 -0. 3 \r\n");
+  const Record r = load_record(spec_for(p));
+  ASSERT_EQ(r.accel_mps2.size(), 6u);
+  EXPECT_DOUBLE_EQ(r.dt_s, 0.01);
+  const double g[] = {1.0, -0.5, 2.5, 1e-3, 0.0, 3.0};
+  for (int i = 0; i < 6; ++i) EXPECT_DOUBLE_EQ(r.accel_mps2[i], g[i] * kG) << i;
+}
+
+TEST_F(RecordFiles, At2UnitsFromHeader) {
+  const std::string body = "NPTS= 2, DT= .02000 SEC\n 100. 200.\n";
+  const Record cm =
+      load_record(spec_for(write("cm.at2", "ACCELERATION IN UNITS OF CM/S/S\n" + body)));
+  EXPECT_DOUBLE_EQ(cm.accel_mps2[1], 2.0);
+  const Record gal = load_record(spec_for(write("gal.at2", "The units are (gal)\n" + body)));
+  EXPECT_DOUBLE_EQ(gal.accel_mps2[0], 1.0);
+  const Record g = load_record(spec_for(write("g.at2", "Peknold\nThe units are (g)\n" + body)));
+  EXPECT_DOUBLE_EQ(g.accel_mps2[0], 100.0 * kG);
+  // No units in the header: the spec's units apply.
+  RecordSpec s = spec_for(write("none.at2", "TITLE\n" + body));
+  s.units = Units::kMps2;
+  EXPECT_DOUBLE_EQ(load_record(s).accel_mps2[0], 100.0);
+}
+
+TEST_F(RecordFiles, ColumnsWithCommentsCrlfAndOffset) {
+  const std::string p = write("c.txt",
+                              "# time  a1  a2\r\n"
+                              "\r\n"
+                              "1.00\t10\t-20   \r\n"
+                              "1.50 30 -40 # comment\r\n"
+                              "# interlude\r\n"
+                              "2.00 50 -60\r\n");
+  RecordSpec s = spec_for(p);
+  s.units = Units::kCmps2;
+  s.column = 2;
+  s.scale = 2.0;
+  const Record r = load_record(s);
+  ASSERT_EQ(r.accel_mps2.size(), 3u);
+  EXPECT_DOUBLE_EQ(r.t0_s, 1.0);
+  EXPECT_DOUBLE_EQ(r.dt_s, 0.5);
+  EXPECT_DOUBLE_EQ(r.accel_mps2[0], -0.4);
+  EXPECT_DOUBLE_EQ(r.accel_mps2[2], -1.2);
+  EXPECT_DOUBLE_EQ(r.pga_mps2(), 1.2);
+}
+
+TEST_F(RecordFiles, TimeJitterWithinToleranceIsAccepted) {
+  // Times printed to 5 decimals, as in the Mexico record.
+  const Record r =
+      load_record(spec_for(write("j.txt", "0.02 1\n0.03999 2\n0.06000 3\n0.08001 4\n0.1 5\n")));
+  EXPECT_DOUBLE_EQ(r.dt_s, 0.02);
+  EXPECT_DOUBLE_EQ(r.t0_s, 0.02);
+}
+
+TEST_F(RecordFiles, AccelOnlyNeedsDt) {
+  const std::string multi = write("m.txt", "1 2 3\n4 5\n\n6\n");
+  RecordSpec s = spec_for(multi, RecordFormat::kAccel);
+  s.dt_s = 0.005;
+  s.units = Units::kMps2;
+  const Record r = load_record(s);
+  ASSERT_EQ(r.accel_mps2.size(), 6u);
+  EXPECT_DOUBLE_EQ(r.accel_mps2[5], 6.0);
+  EXPECT_DOUBLE_EQ(r.dt_s, 0.005);
+  EXPECT_DOUBLE_EQ(r.t0_s, 0.0);
+
+  // Auto: one column is accel-only.
+  RecordSpec one = spec_for(write("one.txt", "0.1\n0.2\n"));
+  one.dt_s = 0.01;
+  EXPECT_DOUBLE_EQ(load_record(one).accel_mps2[1], 0.2 * kG);
+}
+
+// ---- bad files: each error names the file and, where it applies, the line ----
+
+TEST_F(RecordFiles, MissingOrUnreadable) {
+  const std::string missing = (dir_ / "nope.at2").string();
+  EXPECT_NE(error_of(spec_for(missing)).find(missing + ": file not found"), std::string::npos);
+  EXPECT_NE(error_of(spec_for(dir_.string())).find("directory"), std::string::npos);
+}
+
+TEST_F(RecordFiles, EmptyAndNoSamples) {
+  const std::string empty = write("empty.txt", "");
+  EXPECT_EQ(error_of(spec_for(empty)), empty + ": empty file");
+  const std::string blank = write("blank.txt", "\n  \r\n\t\n");
+  EXPECT_EQ(error_of(spec_for(blank)), blank + ": empty file");
+  const std::string comments = write("comments.txt", "# nothing\n# here\n");
+  EXPECT_EQ(error_of(spec_for(comments)), comments + ": no samples");
+  const std::string header_only = write("h.at2", "NPTS= 3, DT= .01 SEC\n");
+  EXPECT_EQ(error_of(spec_for(header_only)),
+            header_only + ":1: NPTS=3 in the header but 0 values read");
+}
+
+TEST_F(RecordFiles, NonNumericToken) {
+  const std::string p = write("bad.at2", "T\nT\nT\nNPTS= 4, DT= .01\n 1 2\n 3 x4y\n");
+  const std::string e = error_of(spec_for(p));
+  EXPECT_NE(e.find(p + ":6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("'x4y'"), std::string::npos) << e;
+  // Glued or doubled signs are not numbers either.
+  const std::string q = write("signs.txt", "0 1\n0.01 +-1\n");
+  EXPECT_NE(error_of(spec_for(q)).find(q + ":2: non-numeric token '+-1'"), std::string::npos);
+}
+
+TEST_F(RecordFiles, NonFiniteValues) {
+  for (const char* tok : {"nan", "NaN", "inf", "-Infinity", "1e999"}) {
+    const std::string p = write("nf.txt", std::string("0 1\n0.01 2\n\n0.02 ") + tok + "\n");
+    const std::string e = error_of(spec_for(p));
+    EXPECT_NE(e.find(p + ":4: non-finite value '" + tok + "'"), std::string::npos) << e;
+  }
+}
+
+TEST_F(RecordFiles, NptsMismatch) {
+  const std::string p = write("n.at2", "A\nB\nUNITS OF G\nNPTS=  5, DT= .02000 SEC\n1 2 3 4\n");
+  const std::string e = error_of(spec_for(p));
+  EXPECT_EQ(e, p + ":4: NPTS=5 in the header but 4 values read");
+  const std::string more = write("m.at2", "NPTS=  2, DT= .02\n1 2 3\n");
+  EXPECT_NE(error_of(spec_for(more)).find("NPTS=2 in the header but 3 values read"),
+            std::string::npos);
+}
+
+TEST_F(RecordFiles, BadHeaderDt) {
+  const std::string zero = write("z.at2", "X\nNPTS= 2, DT= 0.0 SEC\n1 2\n");
+  EXPECT_NE(error_of(spec_for(zero)).find(zero + ":2: DT must be positive"), std::string::npos);
+  const std::string neg = write("n.at2", "NPTS= 2, DT= -.01 SEC\n1 2\n");
+  EXPECT_NE(error_of(spec_for(neg)).find(neg + ":1: DT must be positive"), std::string::npos);
+  const std::string junk = write("j.at2", "NPTS= 2, DT= ..1 SEC\n1 2\n");
+  EXPECT_NE(error_of(spec_for(junk)).find(junk + ":1: non-numeric token '..1'"), std::string::npos);
+  const std::string none = write("none.at2", "1 2\n3 4\n");
+  EXPECT_NE(error_of(spec_for(none, RecordFormat::kAt2)).find("no 'NPTS= .., DT= ..' header"),
+            std::string::npos);
+  const std::string vel =
+      write("v.vt2", "PEER\nX\nVELOCITY TIME SERIES IN UNITS OF CM/S\nNPTS= 1, DT= .01\n1\n");
+  EXPECT_EQ(error_of(spec_for(vel)), vel + ":3: not an acceleration record");
+}
+
+TEST_F(RecordFiles, BadTimeColumn) {
+  const std::string same = write("s.txt", "0 1\n0.02 1\n0.02 1\n0.06 1\n");
+  EXPECT_NE(error_of(spec_for(same)).find(same + ":3: time does not increase"), std::string::npos);
+  const std::string back = write("b.txt", "0 1\n# c\n0.02 1\n0.01 1\n0.06 1\n");
+  EXPECT_NE(error_of(spec_for(back)).find(back + ":4: time does not increase"), std::string::npos);
+  const std::string uneven = write("u.txt", "0 1\n0.02 1\n0.05 1\n0.06 1\n");
+  EXPECT_NE(error_of(spec_for(uneven)).find(uneven + ":3: non-uniform time step"),
+            std::string::npos);
+  // Steps within tolerance that drift off the grid are caught too.
+  const std::string drift =
+      write("d.txt", "0 1\n0.9992 1\n1.9984 1\n2.9976 1\n3.9984 1\n4.9992 1\n6 1\n");
+  EXPECT_NE(error_of(spec_for(drift)).find(drift + ":3: non-uniform"), std::string::npos);
+  const std::string single = write("one.txt", "0.5 1\n");
+  EXPECT_NE(error_of(spec_for(single)).find(single + ":1: a time column needs at least 2"),
+            std::string::npos);
+}
+
+TEST_F(RecordFiles, MissingDt) {
+  const std::string p = write("a.txt", "1\n2\n");
+  EXPECT_NE(error_of(spec_for(p)).find(p + ": accel-only record needs dt > 0"), std::string::npos);
+  RecordSpec s = spec_for(p, RecordFormat::kAccel);
+  s.dt_s = -0.01;
+  EXPECT_NE(error_of(s).find("needs dt > 0"), std::string::npos);
+}
+
+TEST_F(RecordFiles, ColumnOutOfRangeAndRagged) {
+  const std::string p = write("c.txt", "\n0 1 2 3\n0.1 1 2 3\n");
+  RecordSpec s = spec_for(p);
+  s.column = 4;
+  EXPECT_EQ(error_of(s), p + ":2: column 4 out of range: the file has 3 acceleration column(s)");
+  s.column = 0;
+  EXPECT_NE(error_of(s).find("column 0 out of range"), std::string::npos);
+  const std::string one = write("one.txt", "1\n2\n");
+  EXPECT_NE(
+      error_of(spec_for(one, RecordFormat::kTimeAccel)).find(one + ":1: time/accel record needs"),
+      std::string::npos);
+
+  const std::string ragged = write("r.txt", "0 1 2\n0.1 1 2\n0.2 1\n");
+  EXPECT_EQ(error_of(spec_for(ragged)), ragged + ":3: expected 3 columns, found 2");
+}
+
+TEST_F(RecordFiles, BinaryGarbageIsAnErrorNotACrash) {
+  std::string bytes(4096, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>((i * 37) & 0xff);
+  const std::string p = write("garbage.bin", bytes);
+  EXPECT_NE(error_of(spec_for(p)).find(p + ":"), std::string::npos);
+}
+
+// ---- resample: exact at knots, linear between, zero before t0 and after the ramp ----
+
+Record make_record(std::vector<double> a, double dt, double t0 = 0.0) {
+  Record r;
+  r.path = "mem";
+  r.dt_s = dt;
+  r.t0_s = t0;
+  r.accel_mps2 = std::move(a);
+  return r;
+}
+
+TEST(Resample, KnotsLinearAndZeroTail) {
+  const Record r = make_record({1.0, 2.0, -3.0}, 0.02);
+  const std::vector<double> out = resample(r, 100.0);  // two output samples per dt
+  const std::vector<double> want = {1.0, 1.5, 2.0, -0.5, -3.0, -1.5, 0.0};
+  ASSERT_EQ(out.size(), want.size());  // K = round(3 * 0.02 * 100) = 6
+  for (std::size_t k = 0; k < want.size(); ++k) EXPECT_DOUBLE_EQ(out[k], want[k]) << k;
+  EXPECT_EQ(out[0], 1.0);
+  EXPECT_EQ(out[2], 2.0);
+  EXPECT_EQ(out[4], -3.0);
+}
+
+TEST(Resample, OffsetStartIsZeroBeforeT0) {
+  const Record r = make_record({4.0, 8.0}, 0.1, 0.25);
+  const std::vector<double> out = resample(r, 20.0);        // t_k = 0, .05, ..., .45
+  ASSERT_EQ(out.size(), 10u);                               // K = round(0.45 * 20) = 9
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(out[k], 0.0) << k;  // t < 0.25: before the record
+  EXPECT_EQ(out[5], 4.0);                                   // t = 0.25: first knot
+  EXPECT_DOUBLE_EQ(out[6], 6.0);                            // t = 0.30: half-way to 8
+  EXPECT_EQ(out[7], 8.0);                                   // t = 0.35: last knot
+  EXPECT_DOUBLE_EQ(out[8], 4.0);                            // t = 0.40: ramp to zero
+  EXPECT_EQ(out[9], 0.0);                                   // t = 0.45: end of record
+}
+
+TEST(Resample, NonIntegerRatioIsLinear) {
+  const Record r = make_record({0.0, 3.0, -1.0, 2.0}, 0.02);
+  const double rate = 30.0;
+  const std::vector<double> out = resample(r, rate);
+  ASSERT_EQ(out.size(), static_cast<std::size_t>(std::llround(0.08 * rate)) + 1);
+  const double ext[] = {0.0, 3.0, -1.0, 2.0, 0.0};
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const double u = static_cast<double>(k) / rate / 0.02;
+    const std::size_t i = static_cast<std::size_t>(u);
+    const double want = i >= 4 ? 0.0 : ext[i] + (u - i) * (ext[i + 1] - ext[i]);
+    EXPECT_NEAR(out[k], want, 1e-12) << k;
+  }
+}
+
+TEST(Resample, BadRateThrows) {
+  const Record r = make_record({1.0}, 0.01);
+  EXPECT_THROW(resample(r, 0.0), RecordError);
+  EXPECT_THROW(resample(r, -5.0), RecordError);
+  EXPECT_THROW(resample(r, std::nan("")), RecordError);
+  EXPECT_THROW(resample(r, 1e12), RecordError);  // far too many samples
+}
+
+// Real records at sensor rates that are multiples of 1/dt: every knot bit for bit.
+TEST(Resample, RealRecordsExactAtKnots) {
+  const std::string dir = motions_dir();
+  if (dir.empty() || !fs::is_directory(dir)) GTEST_SKIP() << "no ground-motion folder: " << dir;
+  struct Case {
+    const char* file;
+    int column;
+    double rate;
+  };
+  const Case cases[] = {
+      {"elcentro_1940_ns_2688pts_dt002_time_g.dat", 1, 1000.0},
+      {"kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2", 1, 500.0},
+      {"lomaprieta_1989_corralitos_CLS000_nga_west2_rsn753.at2", 1, 1000.0},
+      {"elcentro_1940_ns_peer_legacy_I-ELC180_dt001.at2", 1, 300.0},
+      {"mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt", 2, 1000.0},
+  };
+  for (const Case& c : cases) {
+    RecordSpec s = spec_for(dir + "/" + c.file);
+    s.column = c.column;
+    const Record r = load_record(s);
+    const std::vector<double> out = resample(r, c.rate);
+    const long long per = std::llround(r.dt_s * c.rate);
+    const long long first = std::llround(r.t0_s * c.rate);
+    const std::size_t n = r.accel_mps2.size();
+    ASSERT_EQ(out.size(), static_cast<std::size_t>(first + per * static_cast<long long>(n)) + 1)
+        << c.file;
+    for (long long k = 0; k < first; ++k) ASSERT_EQ(out[k], 0.0) << c.file << " k=" << k;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(out[first + per * i], r.accel_mps2[i]) << c.file << " knot " << i;
+    }
+    // Last dt ramps linearly to zero.
+    const double last = r.accel_mps2.back();
+    for (long long j = 0; j <= per; ++j) {
+      const std::size_t k = first + per * (n - 1) + j;
+      EXPECT_NEAR(out[k], last * (1.0 - static_cast<double>(j) / per), 1e-12) << c.file;
+    }
+  }
+}
+
+// ---- RecordSource and SimClock ----
+
+TEST(RecordSourceTest, HandsOutSamplesAndAdvancesClockExactly) {
+  SimClock clock;
+  const std::size_t n = 3001;
+  std::vector<double> samples(n);
+  for (std::size_t i = 0; i < n; ++i) samples[i] = 0.5 * static_cast<double>(i);
+  RecordSource src(samples, 3.0, &clock);  // period 333333333.3 ns: rounding must not drift
+  EXPECT_DOUBLE_EQ(src.rate_hz(), 3.0);
+  EXPECT_EQ(src.size(), n);
+
+  double a = -1.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    ASSERT_TRUE(src.next(&a));
+    ASSERT_EQ(a, samples[k]);
+    ASSERT_EQ(clock.now_ns(), static_cast<std::uint64_t>(std::llround(k * 1e9 / 3.0))) << k;
+    ASSERT_EQ(src.position(), k + 1);
+  }
+  EXPECT_EQ(clock.now_ns(), 1'000'000'000'000ull);
+  // End of stream: false, nothing written, clock unchanged.
+  a = 42.0;
+  EXPECT_FALSE(src.next(&a));
+  EXPECT_EQ(a, 42.0);
+  EXPECT_EQ(clock.now_ns(), 1'000'000'000'000ull);
+}
+
+TEST(RecordSourceTest, WorksWithoutClockAndRejectsBadRate) {
+  RecordSource src({1.0, 2.0}, 1000.0);
+  double a = 0.0;
+  EXPECT_TRUE(src.next(&a));
+  EXPECT_TRUE(src.next(&a));
+  EXPECT_EQ(a, 2.0);
+  EXPECT_FALSE(src.next(&a));
+  EXPECT_THROW(RecordSource({1.0}, 0.0), std::invalid_argument);
+}
+
+}  // namespace

@@ -1,0 +1,432 @@
+// Scene files: the shipped scenes parse to the MODEL.md parameters, every kind
+// of bad scene is refused with a message that names the key, and record files
+// are found where resolve_record_path says.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "sim_host/scene.hpp"
+
+namespace {
+
+using vines::ContactLaw;
+using vines::DampingRule;
+using vines::DeviceKind;
+using vines::host::load_scene;
+using vines::host::parse_scene;
+using vines::host::resolve_record_path;
+using vines::host::Scene;
+using vines::host::SceneError;
+namespace fs = std::filesystem;
+
+const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+const char* kElCentro = "elcentro_1940_ns_2688pts_dt002_time_g.dat";
+
+// A valid VI NES scene; tests append or replace parts of it.
+const std::string kBase = R"(
+[device]
+kind = "vines"
+[record]
+path = "elcentro_1940_ns_2688pts_dt002_time_g.dat"
+)";
+
+// The SceneError message of parsing `text` ("" if it parses).
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "bad.toml");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Expects `text` to be refused with a message containing every part.
+void expect_refused(const std::string& text, std::initializer_list<const char*> parts) {
+  const std::string msg = error_of(text);
+  ASSERT_FALSE(msg.empty()) << "accepted:\n" << text;
+  for (const char* p : parts) EXPECT_NE(msg.find(p), std::string::npos) << msg << "\nlacks: " << p;
+}
+
+// ---- shipped scenes ----
+
+// What every shipped scene shares: Table 1 frame, El Centro, 1000 / 100 Hz.
+void expect_common(const Scene& s) {
+  const vines::FrameParams& f = s.params.frame;
+  EXPECT_EQ(f.stories, 10);
+  EXPECT_DOUBLE_EQ(f.mass_kg[0], 179000.0);
+  EXPECT_DOUBLE_EQ(f.mass_kg[9], 98000.0);
+  EXPECT_DOUBLE_EQ(f.stiffness_n_per_m[0], 62.47e6);
+  EXPECT_DOUBLE_EQ(f.stiffness_n_per_m[1], 52.26e6);
+  EXPECT_DOUBLE_EQ(f.stiffness_n_per_m[9], 34.31e6);
+  EXPECT_EQ(f.damping, DampingRule::kStiffnessProportional);
+  EXPECT_DOUBLE_EQ(f.stiffness_damping_s, 0.0129);
+  EXPECT_DOUBLE_EQ(f.stiffness_scale, 1.0);
+  EXPECT_EQ(s.record.path, kElCentro);
+  EXPECT_EQ(s.record.format, vines::hal::RecordFormat::kTimeAccel);
+  EXPECT_EQ(s.record.units, vines::hal::Units::kG);
+  EXPECT_DOUBLE_EQ(s.record.scale, 1.0);
+  EXPECT_EQ(s.duration_s, 0.0);
+  EXPECT_EQ(s.target_pga_mps2, 0.0);
+  EXPECT_DOUBLE_EQ(s.params.loop.sensor_rate_hz, 1000.0);
+  EXPECT_DOUBLE_EQ(s.output.rate_hz, 100.0);
+  EXPECT_TRUE(s.output.timeseries);
+  EXPECT_EQ(s.scalar, vines::host::Scalar::kDouble);
+  EXPECT_EQ(s.params.device.floor, 0);  // top
+  EXPECT_DOUBLE_EQ(s.params.device.mass_ratio, 0.05);
+  EXPECT_EQ(s.params.device.mass_kg, 0.0);
+  // The record is found through the default ground-motion folder.
+  EXPECT_TRUE(fs::is_regular_file(resolve_record_path(s.record.path, s.path)));
+}
+
+TEST(Scene, Bare) {
+  const Scene s = load_scene(kScenes + "elcentro_bare.toml");
+  expect_common(s);
+  EXPECT_EQ(s.name, "elcentro_bare");
+  EXPECT_EQ(s.params.device.kind, DeviceKind::kNone);
+}
+
+TEST(Scene, Tmd) {
+  const Scene s = load_scene(kScenes + "elcentro_tmd.toml");
+  expect_common(s);
+  EXPECT_EQ(s.params.device.kind, DeviceKind::kTmd);
+  EXPECT_EQ(s.params.device.tmd.k_n_per_m, 0.0);  // Den Hartog
+  EXPECT_EQ(s.params.device.tmd.c_ns_per_m, 0.0);
+}
+
+TEST(Scene, VinesLaws) {
+  const std::pair<const char*, ContactLaw> files[] = {
+      {"elcentro_vines", ContactLaw::kKuwabara},
+      {"elcentro_vines_tsuji", ContactLaw::kTsuji},
+      {"elcentro_vines_hertz", ContactLaw::kHertz},
+      {"elcentro_vines_restitution", ContactLaw::kRestitution}};
+  for (const auto& [stem, law] : files) {
+    SCOPED_TRACE(stem);
+    const Scene s = load_scene(kScenes + stem + ".toml");
+    expect_common(s);
+    EXPECT_EQ(s.name, stem);
+    const vines::VinesParams& v = s.params.device.vines;
+    EXPECT_EQ(s.params.device.kind, DeviceKind::kVines);
+    EXPECT_EQ(v.law, law);
+    EXPECT_DOUBLE_EQ(v.beta, 1.35);
+    EXPECT_EQ(v.box_length_m, 0.0);
+    EXPECT_EQ(v.radius_m, 0.0);
+    EXPECT_DOUBLE_EQ(v.density_kg_m3, 8000.0);
+    EXPECT_DOUBLE_EQ(v.young_pa, 210e9);
+    EXPECT_DOUBLE_EQ(v.poisson, 0.3);
+    EXPECT_DOUBLE_EQ(v.eps, 0.7);
+    EXPECT_DOUBLE_EQ(v.v_ref_mps, 0.5);
+    EXPECT_EQ(v.tau_s, 0.0);
+    EXPECT_TRUE(v.start_at_left_wall);
+    EXPECT_EQ(v.initial_velocity_mps, 0.0);
+  }
+}
+
+// ---- accepted variants ----
+
+TEST(Scene, MinimalDefaults) {
+  const Scene s = parse_scene(kBase, "dir/minimal.toml");
+  EXPECT_EQ(s.name, "minimal");
+  EXPECT_EQ(s.path, "dir/minimal.toml");
+  EXPECT_EQ(s.record.format, vines::hal::RecordFormat::kAuto);
+  EXPECT_EQ(s.params.device.vines.law, ContactLaw::kKuwabara);
+  // No [device] at all: no device.
+  EXPECT_EQ(parse_scene("[record]\npath = \"x.dat\"\n", "x").params.device.kind, DeviceKind::kNone);
+}
+
+TEST(Scene, CustomFrameRayleighAndHostKeys) {
+  const Scene s = parse_scene(R"(
+[scene]
+name = "custom"
+[frame]
+preset = "custom"
+masses_kg = [1000, 2000.5, 3000]
+stiffnesses_n_per_m = [1e6, 2e6, 3e6]
+damping = "rayleigh"
+rayleigh_zeta = [0.01, 0.03]
+rayleigh_modes = [1, 3]
+stiffness_scale = 0.8
+[device]
+kind = "tmd"
+floor = 2
+mass_kg = 150
+[tmd]
+k_n_per_m = 2500
+c_ns_per_m = 30
+initial_position_m = 0.01
+[vines]                # inactive: read, ignored
+beta = 0.5
+[record]
+path = "/abs/rec.txt"
+format = "accel"
+units = "cm/s2"
+dt_s = 0.01
+pga_g = 0.4
+duration_s = 20
+[loop]
+sensor_rate_hz = 2000
+scalar = "float"
+energy_ledger = false
+max_substeps_per_step = 100
+[output]
+rate_hz = 250
+timeseries = false
+)",
+                              "x");
+  const vines::FrameParams& f = s.params.frame;
+  EXPECT_EQ(s.name, "custom");
+  EXPECT_EQ(f.stories, 3);
+  EXPECT_DOUBLE_EQ(f.mass_kg[1], 2000.5);
+  EXPECT_DOUBLE_EQ(f.stiffness_n_per_m[2], 3e6);
+  EXPECT_EQ(f.damping, DampingRule::kRayleigh);
+  EXPECT_DOUBLE_EQ(f.rayleigh_zeta[1], 0.03);
+  EXPECT_EQ(f.rayleigh_modes[1], 3);
+  EXPECT_DOUBLE_EQ(f.stiffness_scale, 0.8);
+  EXPECT_EQ(s.params.device.kind, DeviceKind::kTmd);
+  EXPECT_EQ(s.params.device.floor, 2);
+  EXPECT_DOUBLE_EQ(s.params.device.mass_kg, 150.0);
+  EXPECT_DOUBLE_EQ(s.params.device.tmd.k_n_per_m, 2500.0);
+  EXPECT_DOUBLE_EQ(s.params.device.tmd.c_ns_per_m, 30.0);
+  EXPECT_DOUBLE_EQ(s.params.device.tmd.initial_position_m, 0.01);
+  EXPECT_DOUBLE_EQ(s.params.device.vines.beta, 0.5);  // inactive, not range-checked
+  EXPECT_EQ(s.record.format, vines::hal::RecordFormat::kAccel);
+  EXPECT_EQ(s.record.units, vines::hal::Units::kCmps2);
+  EXPECT_DOUBLE_EQ(s.record.dt_s, 0.01);
+  EXPECT_DOUBLE_EQ(s.target_pga_mps2, 0.4 * vines::kGravity);
+  EXPECT_DOUBLE_EQ(s.duration_s, 20.0);
+  EXPECT_DOUBLE_EQ(s.params.loop.sensor_rate_hz, 2000.0);
+  EXPECT_EQ(s.params.loop.max_substeps_per_step, 100);
+  EXPECT_FALSE(s.params.loop.energy_ledger);
+  EXPECT_EQ(s.scalar, vines::host::Scalar::kFloat);
+  EXPECT_DOUBLE_EQ(s.output.rate_hz, 250.0);
+  EXPECT_FALSE(s.output.timeseries);
+}
+
+TEST(Scene, VinesInitialStateAndBox) {
+  const Scene s = parse_scene(kBase + R"(
+[vines]
+law = "tsuji"
+box_length_m = 3.0
+initial_position_m = -0.2
+initial_velocity_mps = 0.1
+)",
+                              "x");
+  const vines::VinesParams& v = s.params.device.vines;
+  EXPECT_FALSE(v.start_at_left_wall);
+  EXPECT_DOUBLE_EQ(v.initial_position_m, -0.2);
+  EXPECT_DOUBLE_EQ(v.initial_velocity_mps, 0.1);
+  EXPECT_DOUBLE_EQ(v.box_length_m, 3.0);
+  EXPECT_EQ(v.law, ContactLaw::kTsuji);
+}
+
+// ---- refused scenes: each message names the key ----
+
+TEST(SceneError, UnknownKeyAndTable) {
+  expect_refused(kBase + "[vines]\nbetta = 1.3\n", {"bad.toml:7:", "vines.betta", "unknown key"});
+  expect_refused(kBase + "[foo]\nx = 1\n", {"bad.toml:6:", "foo", "unknown table"});
+  expect_refused("top = 1\n" + kBase, {"bad.toml:1:", "top", "unknown table"});
+}
+
+TEST(SceneError, WrongType) {
+  expect_refused(kBase + "[vines]\nbeta = \"big\"\n", {"bad.toml:7:", "vines.beta", "number"});
+  expect_refused(kBase + "[device.x]\n", {"device.x", "unknown key"});
+  expect_refused("device = 3\n" + kBase, {"device", "table"});
+  expect_refused(kBase + "[loop]\nmax_substeps_per_step = 10.0\n",
+                 {"loop.max_substeps_per_step", "integer"});
+  expect_refused(kBase + "[output]\ntimeseries = 1\n", {"output.timeseries", "true or false"});
+  expect_refused(kBase + "[vines]\nlaw = 3\n", {"vines.law", "string"});
+  expect_refused(kBase + "[frame]\nrayleigh_modes = [1, 2.5]\n",
+                 {"frame.rayleigh_modes[1]", "integer"});
+  expect_refused(kBase + "[frame]\nrayleigh_zeta = [0.02]\n",
+                 {"frame.rayleigh_zeta", "2 elements"});
+  // Type errors count in inactive tables too.
+  expect_refused("[device]\nkind = \"tmd\"\n[vines]\nbeta = \"x\"\n[record]\npath = \"a\"\n",
+                 {"vines.beta", "number"});
+}
+
+TEST(SceneError, NegativeMass) {
+  expect_refused(R"(
+[frame]
+preset = "custom"
+masses_kg = [1000, -5]
+stiffnesses_n_per_m = [1e6, 1e6]
+[record]
+path = "a"
+)",
+                 {"bad.toml:4:", "frame.masses_kg[1]", "> 0"});
+  expect_refused("[device]\nkind = \"tmd\"\nmass_kg = -3\n[record]\npath = \"a\"\n",
+                 {"bad.toml:3:", "device.mass_kg", "> 0"});
+  expect_refused(kBase + "[frame]\nstiffness_scale = -1\n", {"frame.stiffness_scale"});
+}
+
+TEST(SceneError, VinesValues) {
+  for (const char* beta : {"1.0", "0.9", "-2", "nan"})
+    expect_refused(kBase + "[vines]\nbeta = " + beta + "\n", {"bad.toml:7:", "vines.beta", "> 1"});
+  for (const char* eps : {"0", "0.0", "1.5", "-0.1"})
+    expect_refused(kBase + "[vines]\neps = " + eps + "\n", {"bad.toml:7:", "vines.eps", "(0, 1]"});
+  EXPECT_EQ(error_of(kBase + "[vines]\neps = 1\n"), "");  // eps = 1 is allowed
+  // eps is not used by the Hertz law: any value passes there.
+  EXPECT_EQ(error_of(kBase + "[vines]\nlaw = \"hertz\"\neps = 0\n"), "");
+  expect_refused(kBase + "[vines]\nlaw = \"kuwabarra\"\n",
+                 {"bad.toml:7:", "vines.law", "\"kuwabara\"", "kuwabarra"});
+  expect_refused(kBase + "[vines]\npoisson = 0.5\n", {"vines.poisson"});
+  expect_refused(kBase + "[vines]\nv_ref_mps = 0\n", {"vines.v_ref_mps"});
+}
+
+TEST(SceneError, ZeroMeansDefaultKeys) {
+  expect_refused(kBase + "[vines]\ntau_s = 0\n", {"vines.tau_s", "leave the key out"});
+  expect_refused(kBase + "[vines]\nradius_m = 0.0\n", {"vines.radius_m", "leave the key out"});
+  expect_refused(
+      "[device]\nkind = \"tmd\"\n[tmd]\nk_n_per_m = 1e5\nc_ns_per_m = 0\n"
+      "[record]\npath = \"a\"\n",
+      {"tmd.c_ns_per_m", "leave the key out"});
+  // c without k is refused by validate.
+  expect_refused("[device]\nkind = \"tmd\"\n[tmd]\nc_ns_per_m = 10\n[record]\npath = \"a\"\n",
+                 {"bad.toml:4:", "tmd.c_ns_per_m", "k_n_per_m"});
+}
+
+TEST(SceneError, Conflicts) {
+  expect_refused(kBase + "[vines]\nbeta = 1.3\nbox_length_m = 3\n",
+                 {"bad.toml:8:", "vines.box_length_m", "vines.beta"});
+  expect_refused(kBase + "[vines]\nv_ref_mps = 0.5\ntau_s = 1e-3\n", {"vines.tau_s", "conflicts"});
+  expect_refused(
+      "[device]\nkind = \"vines\"\nmass_ratio = 0.05\nmass_kg = 1e4\n[record]\npath = \"a\"\n",
+      {"device.mass_kg", "conflicts"});
+  expect_refused(
+      "[device]\nkind = \"vines\"\nmass_ratio = 0.05\n[vines]\nradius_m = 1\n"
+      "[record]\npath = \"a\"\n",
+      {"vines.radius_m", "device.mass_ratio"});
+  expect_refused(kBase + "scale = 2\npga_g = 0.3\n", {"record.pga_g", "conflicts"});
+}
+
+TEST(SceneError, DeviceKindAndFloor) {
+  expect_refused("[device]\nkind = \"nes\"\n[record]\npath = \"a\"\n",
+                 {"bad.toml:2:", "device.kind", "\"vines\"", "nes"});
+  expect_refused("[device]\nfloor = 3\n[record]\npath = \"a\"\n", {"device.kind", "required"});
+  expect_refused(kBase.substr(0, kBase.find("[record]")) + "floor = 11\n[record]\npath = \"a\"\n",
+                 {"bad.toml:4:", "device.floor"});
+  expect_refused(kBase.substr(0, kBase.find("[record]")) + "floor = 0\n[record]\npath = \"a\"\n",
+                 {"device.floor", "top floor"});
+}
+
+TEST(SceneError, FramePresetAndArrays) {
+  expect_refused(kBase + "[frame]\npreset = \"table2\"\n",
+                 {"bad.toml:7:", "frame.preset", "table2"});
+  expect_refused(
+      kBase + "[frame]\npreset = \"custom\"\nmasses_kg = [1, 2]\nstiffnesses_n_per_m = [1]\n",
+      {"bad.toml:9:", "frame.stiffnesses_n_per_m", "2"});
+  expect_refused(kBase + "[frame]\npreset = \"custom\"\nstiffnesses_n_per_m = [1]\n",
+                 {"frame.masses_kg", "required"});
+  expect_refused(kBase + "[frame]\npreset = \"custom\"\nmasses_kg = []\nstiffnesses_n_per_m = []\n",
+                 {"frame.masses_kg", "1 to 40"});
+  std::string many = "[";
+  for (int i = 0; i < 41; ++i) many += "1.0, ";
+  many += "]";
+  expect_refused(kBase + "[frame]\npreset = \"custom\"\nmasses_kg = " + many +
+                     "\nstiffnesses_n_per_m = " + many + "\n",
+                 {"frame.masses_kg", "1 to 40"});
+  expect_refused(kBase + "[frame]\nmasses_kg = [1.0]\n", {"frame.masses_kg", "custom"});
+  expect_refused(kBase + "[frame]\ndamping = \"viscous\"\n", {"frame.damping"});
+  expect_refused(kBase + "[frame]\ndamping = \"rayleigh\"\nrayleigh_modes = [2, 2]\n",
+                 {"frame.rayleigh_modes", "different"});
+  expect_refused(kBase + "[frame]\ndamping = \"modal\"\nmodal_zeta = 1.0\n", {"frame.modal_zeta"});
+}
+
+TEST(SceneError, HostKeys) {
+  expect_refused(kBase + "[loop]\nsensor_rate_hz = 100\n[output]\nrate_hz = 200\n",
+                 {"bad.toml:9:", "output.rate_hz", "sensor_rate_hz"});
+  expect_refused(kBase + "[loop]\nsensor_rate_hz = 50\n", {"output.rate_hz", "default"});
+  expect_refused(kBase + "[output]\nrate_hz = 300\n", {"output.rate_hz", "divide"});
+  expect_refused(kBase + "[output]\nrate_hz = 0\n", {"output.rate_hz", "> 0"});
+  expect_refused(kBase + "[loop]\nsensor_rate_hz = 0\n", {"loop.sensor_rate_hz"});
+  expect_refused(kBase + "[loop]\nscalar = \"half\"\n", {"loop.scalar", "\"float\""});
+  expect_refused("[scene]\nname = \"\"\n" + kBase, {"bad.toml:2:", "scene.name", "empty"});
+  expect_refused("[device]\nkind = \"none\"\n", {"record", "missing"});
+  expect_refused("[record]\nformat = \"at2\"\n", {"record.path", "required"});
+  expect_refused(kBase + "format = \"accel\"\n", {"record.dt_s", "required"});
+  expect_refused(kBase + "dt_s = 0.02\n", {"record.dt_s", "accel"});
+  expect_refused(kBase + "format = \"at2\"\ncolumn = 2\n", {"record.column"});
+  expect_refused(kBase + "column = 0\n", {"record.column", ">= 1"});
+  expect_refused(kBase + "units = \"ft/s2\"\n", {"record.units"});
+  expect_refused(kBase + "scale = 0\n", {"record.scale"});
+  expect_refused(kBase + "pga_g = -1\n", {"record.pga_g"});
+  expect_refused(kBase + "duration_s = -1\n", {"record.duration_s"});
+}
+
+TEST(SceneError, SyntaxErrorHasLine) {
+  const std::string msg = error_of("[device]\nkind = \"vines\"\nbeta = = 2\n");
+  EXPECT_NE(msg.find("bad.toml:3:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("syntax"), std::string::npos) << msg;
+  expect_refused(kBase + "[device]\nkind = \"tmd\"\n", {"bad.toml:6:", "device"});  // defined twice
+}
+
+TEST(SceneError, MissingFile) {
+  try {
+    load_scene("/nonexistent/dir/scene.toml");
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/scene.toml"), std::string::npos);
+  }
+}
+
+// ---- record search ----
+
+// A scratch folder with one record file in it.
+class RecordSearch : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("vines_scene_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_ / "scenes");
+    std::ofstream(dir_ / "here.dat") << "0 0\n";
+    std::ofstream(dir_ / "scenes" / "beside.dat") << "0 0\n";
+    const char* env = std::getenv("VINES_GROUND_MOTIONS");
+    saved_env_ = env != nullptr ? env : "";
+    had_env_ = env != nullptr;
+  }
+  void TearDown() override {
+    if (had_env_)
+      setenv("VINES_GROUND_MOTIONS", saved_env_.c_str(), 1);
+    else
+      unsetenv("VINES_GROUND_MOTIONS");
+    fs::remove_all(dir_);
+  }
+  fs::path dir_;
+  std::string saved_env_;
+  bool had_env_ = false;
+};
+
+TEST_F(RecordSearch, Order) {
+  const std::string scene = (dir_ / "scenes" / "s.toml").string();
+  unsetenv("VINES_GROUND_MOTIONS");
+  // Absolute: as is. Scene folder. Default ground-motion folder.
+  EXPECT_EQ(resolve_record_path((dir_ / "here.dat").string(), scene), (dir_ / "here.dat").string());
+  EXPECT_EQ(resolve_record_path("beside.dat", scene), (dir_ / "scenes" / "beside.dat").string());
+  EXPECT_EQ(resolve_record_path(kElCentro, scene),
+            (fs::path(VINES_DEFAULT_GROUND_MOTIONS) / kElCentro).lexically_normal().string());
+  // $VINES_GROUND_MOTIONS replaces the default folder.
+  setenv("VINES_GROUND_MOTIONS", dir_.c_str(), 1);
+  EXPECT_EQ(resolve_record_path("here.dat", scene), (dir_ / "here.dat").string());
+  EXPECT_THROW(resolve_record_path(kElCentro, scene), SceneError);
+}
+
+TEST_F(RecordSearch, NotFoundListsPlaces) {
+  setenv("VINES_GROUND_MOTIONS", (dir_ / "gm").c_str(), 1);
+  const std::string scene = (dir_ / "scenes" / "s.toml").string();
+  try {
+    resolve_record_path("nope.dat", scene);
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    const std::string msg = e.what();
+    for (const std::string& part :
+         {std::string("nope.dat"), std::string("working directory"),
+          (dir_ / "scenes" / "nope.dat").string(), (dir_ / "gm" / "nope.dat").string(),
+          std::string("$VINES_GROUND_MOTIONS")})
+      EXPECT_NE(msg.find(part), std::string::npos) << msg << "\nlacks: " << part;
+  }
+  EXPECT_THROW(resolve_record_path((dir_ / "nope.dat").string(), scene), SceneError);
+}
+
+}  // namespace
