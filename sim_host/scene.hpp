@@ -8,11 +8,10 @@
 #include <string>
 
 #include "host/record.hpp"
+#include "sim_host/scalar.hpp"
 #include "vines/params.hpp"
 
 namespace vines::host {
-
-enum class Scalar { kDouble, kFloat };
 
 struct OutputSpec {
   double rate_hz = 100.0;  // timeseries rows per second of record (<= sensor rate)

@@ -53,7 +53,7 @@ struct Data {
 
   std::int64_t k = 0;  // samples consumed; the state is at t = k h
   S a_prev = S(0);     // ground acceleration at the current time
-  VecX z;              // linear part
+  VecX z = VecX::Zero();  // linear part
 
   // VI NES particle: s = displacement from its start (relative to ground).
   S s = S(0), sd = S(0);
@@ -64,9 +64,9 @@ struct Data {
   S max_overlap = S(0);     // deepest overlap of the run
 
   // Outputs at the current time.
-  VecN x, v;
+  VecN x = VecN::Zero(), v = VecN::Zero();
   // Running maxima over the whole run (continuous in time, not just samples).
-  VecN peak_x, peak_drift;
+  VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();
   S peak_top = S(0);
   double t_peak_top = 0;
   double elastic_energy = 0;  // E_e = integral of (1/2) x^T K x dt [J s]

@@ -182,6 +182,10 @@ template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   const auto& dm = m.dev;
+#ifdef VINES_TRACE
+  std::printf("event t=%.6f mode=%d side=%d r=%.6e rd=%.6e depth=%.3e\n", d.time(m), (int)st.mode, side,
+              (double)st.rel_pos(y), (double)st.rel_vel(y), (double)d.contact_depth);
+#endif
   switch (st.mode) {
     case Mode::kFree:
       if constexpr (Dev::kLaw == ContactLaw::kRestitution) {
@@ -276,8 +280,8 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   ++d.count.careful_steps;
   // Event function of the current mode: crosses zero upwards at the event.
   auto event_value = [&](const Vec& yy, const Vec& ff, int side, S* slope) {
-    const S r = st.rel_pos(yy);
-    const S rd = ff(NX) - m.floor_v(typename Model<S, N, Dev>::VecX(ff.template head<NX>()), m.floor);
+    (void)ff;
+    const S r = st.rel_pos(yy), rd = st.rel_vel(yy);
     switch (st.mode) {
       case Mode::kFree:  // overlap with wall `side` becomes positive
         *slope = side < 0 ? -rd : rd;

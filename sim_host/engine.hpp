@@ -1,0 +1,75 @@
+// Host access to one compiled instance of the firmware core. The core is a set
+// of templates over (scalar, story count, device); an Engine hides which one a
+// scene needs behind a small virtual interface so that host programs can pick
+// it at run time. Each instance lives in its own translation unit, compiled
+// with the firmware's flags (no exceptions, no RTTI).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "sim_host/scalar.hpp"
+#include "vines/data.hpp"
+#include "vines/params.hpp"
+#include "vines/validate.hpp"
+
+namespace vines::host {
+
+using FloorArray = std::array<double, kMaxStories>;
+
+// The outputs of one step, in double.
+struct Snapshot {
+  double t = 0, ag = 0;
+  FloorArray x{}, v{}, acc{}, drift{};  // relative disp./vel., absolute acc., story drift
+  double elastic_energy = 0;            // E_e so far [J s]
+  // VI NES
+  double particle_x = 0, particle_v = 0;  // centre relative to ground, from the box centre at rest
+  double wall_left = 0, wall_right = 0;   // where the particle centre touches each wall
+  double contact_force = 0;               // on the particle, positive to the right
+  int mode = 0;                           // vines::Mode
+  // TMD
+  double tmd_x = 0, tmd_v = 0;
+};
+
+// Everything a run summary reports that the model knows.
+struct ModelInfo {
+  int stories = 0;
+  FloorArray frequency_hz{}, zeta{}, gamma{}, m_eff{};
+  std::array<FloorArray, kMaxStories> mode_shapes{};  // mode_shapes[j][i]: floor i of mode j
+  double total_mass = 0;
+  double sensor_period = 0;
+  int device_floor = 0;  // 1-based
+  TmdDesign tmd;
+  VinesDesign vines;
+};
+
+struct RunTotals {
+  FloorArray peak_x{}, peak_drift{};
+  double peak_top = 0, t_peak_top = 0;
+  double elastic_energy = 0, strain_increments = 0;
+  double max_overlap = 0;
+  Ledger ledger;
+  Counters count;
+};
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  // Builds the model; the parameters must fit this engine (see make_engine).
+  virtual ParamError build(const SceneParams& p) = 0;
+  virtual ModelInfo info() const = 0;
+  virtual void init(double a0) = 0;
+  virtual void step(double a1) = 0;
+  virtual Snapshot snapshot() const = 0;
+  virtual RunTotals totals() const = 0;
+};
+
+// The engine for a scene's story count, device and law, or nullptr if this
+// build does not include that story count (see VINES_STORY_COUNTS).
+std::unique_ptr<Engine> make_engine(const SceneParams& p, Scalar scalar);
+
+// Story counts compiled into this build, for messages.
+const char* compiled_story_counts();
+
+}  // namespace vines::host

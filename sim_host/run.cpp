@@ -1,0 +1,245 @@
+#include "sim_host/run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace vines::host {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* device_name(DeviceKind k) {
+  switch (k) {
+    case DeviceKind::kTmd: return "tmd";
+    case DeviceKind::kVines: return "vines";
+    default: return "none";
+  }
+}
+
+const char* law_name(ContactLaw l) {
+  switch (l) {
+    case ContactLaw::kHertz: return "hertz";
+    case ContactLaw::kTsuji: return "tsuji";
+    case ContactLaw::kKuwabara: return "kuwabara";
+    default: return "restitution";
+  }
+}
+
+std::vector<double> head(const FloorArray& a, int n) { return {a.begin(), a.begin() + n}; }
+
+// One engine run over the samples; snapshots every `every` steps.
+struct Trace {
+  RunTotals totals;
+  ModelInfo info;
+  std::vector<Snapshot> rows;
+  double wall_s = 0;
+};
+
+Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
+  std::unique_ptr<Engine> eng = make_engine(p, scene.scalar);
+  if (!eng)
+    throw std::runtime_error(scene.path + ": frame.stories: this build has frames of " +
+                             std::string(compiled_story_counts()) +
+                             " stories; reconfigure with -DVINES_STORY_COUNTS=\"...;" +
+                             std::to_string(p.frame.stories) + "\"");
+  const ParamError e = eng->build(p);
+  if (!e.ok()) {
+    std::string key = e.field;
+    if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
+    throw std::runtime_error(scene.path + ": " + key + ": " + e.message);
+  }
+  Trace tr;
+  tr.info = eng->info();
+  const auto t0 = std::chrono::steady_clock::now();
+  eng->init(ex.samples[0]);
+  if (every > 0) tr.rows.push_back(eng->snapshot());
+  for (std::size_t k = 1; k < ex.samples.size(); ++k) {
+    eng->step(ex.samples[k]);
+    if (every > 0 && k % static_cast<std::size_t>(every) == 0) tr.rows.push_back(eng->snapshot());
+  }
+  tr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  tr.totals = eng->totals();
+  return tr;
+}
+
+json modal_json(const ModelInfo& in) {
+  const int n = in.stories;
+  json mass_fraction = json::array();
+  for (int j = 0; j < n; ++j) mass_fraction.push_back(in.m_eff[j] / in.total_mass);
+  return {{"frequency_hz", head(in.frequency_hz, n)},
+          {"damping_ratio", head(in.zeta, n)},
+          {"effective_mass_kg", head(in.m_eff, n)},
+          {"effective_mass_fraction", mass_fraction},
+          {"participation_factor", head(in.gamma, n)},
+          {"total_mass_kg", in.total_mass}};
+}
+
+json response_json(const Trace& tr) {
+  const int n = tr.info.stories;
+  const RunTotals& t = tr.totals;
+  return {{"peak_displacement_m", head(t.peak_x, n)},
+          {"peak_drift_m", head(t.peak_drift, n)},
+          {"peak_top_displacement_m", t.peak_top},
+          {"t_peak_top_s", t.t_peak_top},
+          {"elastic_energy_integral", t.elastic_energy},
+          {"strain_energy_positive_increments", t.strain_increments}};
+}
+
+void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  const int n = dev.info.stories;
+  const DeviceKind kind = scene.params.device.kind;
+  out << "t_s,ag_mps2";
+  for (const char* q : {"x", "v", "acc", "drift"})
+    for (int i = 1; i <= n; ++i)
+      out << ',' << q << i << (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2");
+  out << ",Ee_Js";
+  if (kind == DeviceKind::kVines)
+    out << ",particle_x_m,particle_v_mps,wall_left_m,wall_right_m,contact_force_n,contact_mode";
+  if (kind == DeviceKind::kTmd) out << ",tmd_x_m,tmd_v_mps";
+  if (bare) out << ",bare_x_top_m,bare_Ee_Js";
+  out << '\n';
+  char buf[64];
+  auto put = [&](double v) {
+    std::snprintf(buf, sizeof buf, ",%.9g", v);
+    out << buf;
+  };
+  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
+    const Snapshot& s = dev.rows[r];
+    std::snprintf(buf, sizeof buf, "%.6f", s.t);
+    out << buf;
+    put(s.ag);
+    for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift})
+      for (int i = 0; i < n; ++i) put((*a)[i]);
+    put(s.elastic_energy);
+    if (kind == DeviceKind::kVines) {
+      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) put(v);
+      out << ',' << s.mode;
+    }
+    if (kind == DeviceKind::kTmd) {
+      put(s.tmd_x);
+      put(s.tmd_v);
+    }
+    if (bare) {
+      put(bare->rows[r].x[n - 1]);
+      put(bare->rows[r].elastic_energy);
+    }
+    out << '\n';
+  }
+}
+
+}  // namespace
+
+Excitation load_excitation(const Scene& scene, const std::string& record_override) {
+  hal::RecordSpec spec = scene.record;
+  if (!record_override.empty()) spec.path = record_override;
+  spec.path = resolve_record_path(spec.path, scene.path);
+  Excitation ex;
+  ex.record = hal::load_record(spec);
+  if (scene.target_pga_mps2 > 0.0) {
+    const double pga = ex.record.pga_mps2();
+    if (!(pga > 0.0)) throw std::runtime_error(spec.path + ": all samples are zero, cannot scale to pga_g");
+    for (double& a : ex.record.accel_mps2) a *= scene.target_pga_mps2 / pga;
+  }
+  ex.rate_hz = scene.params.loop.sensor_rate_hz;
+  ex.samples = hal::resample(ex.record, ex.rate_hz);
+  if (scene.duration_s > 0.0) {
+    const auto keep = static_cast<std::size_t>(std::llround(scene.duration_s * ex.rate_hz)) + 1;
+    if (keep < ex.samples.size()) ex.samples.resize(keep);
+  }
+  if (ex.samples.size() < 2)
+    throw std::runtime_error(spec.path + ": record too short for one step at the sensor rate");
+  return ex;
+}
+
+json run_scene(const Scene& scene, const RunOptions& opt) {
+  const Excitation ex = load_excitation(scene, opt.record_override);
+  const SceneParams& p = scene.params;
+  const bool has_device = p.device.kind != DeviceKind::kNone;
+  const bool series = !opt.out_dir.empty() && scene.output.timeseries;
+  const int every = series ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz)) : 0;
+
+  const Trace dev = run_engine(scene, p, ex, every);
+  Trace bare;
+  if (has_device) {
+    SceneParams pb = p;
+    pb.device.kind = DeviceKind::kNone;
+    bare = run_engine(scene, pb, ex, every);
+  }
+
+  const RunTotals& t = dev.totals;
+  json j;
+  j["scene"] = scene.name;
+  j["scene_file"] = scene.path;
+  j["device"] = device_name(p.device.kind);
+  if (p.device.kind == DeviceKind::kVines) j["contact_law"] = law_name(p.device.vines.law);
+  j["stories"] = dev.info.stories;
+  j["scalar"] = scalar_name(scene.scalar);
+  j["sensor_rate_hz"] = p.loop.sensor_rate_hz;
+  j["record"] = {{"path", ex.record.path},
+                 {"dt_s", ex.record.dt_s},
+                 {"points", ex.record.accel_mps2.size()},
+                 {"pga_mps2", ex.record.pga_mps2()},
+                 {"simulated_s", static_cast<double>(ex.samples.size() - 1) / ex.rate_hz}};
+  j.update(response_json(dev));
+  if (has_device) {
+    const RunTotals& b = bare.totals;
+    j["x_r"] = (b.peak_top - t.peak_top) / b.peak_top;
+    j["E_r"] = (b.elastic_energy - t.elastic_energy) / b.elastic_energy;
+    j["E_r_positive_increments"] =
+        (b.strain_increments - t.strain_increments) / b.strain_increments;
+    j["bare"] = response_json(bare);
+  }
+  j["contacts"] = t.count.contacts;
+  if (p.device.kind == DeviceKind::kVines) j["max_overlap_m"] = t.max_overlap;
+  if (p.loop.energy_ledger) {
+    const Ledger& l = t.ledger;
+    j["energy_balance_residual"] = l.relative_residual();
+    j["energy_J"] = {{"input", l.input},     {"frame_damping", l.damping}, {"contact_dissipation", l.contact},
+                     {"kinetic", l.kinetic}, {"frame_strain", l.strain},   {"device_stored", l.device},
+                     {"residual", l.residual}};
+  } else {
+    j["energy_balance_residual"] = nullptr;
+  }
+  j["counters"] = {{"steps", t.count.steps},
+                   {"substep_steps", t.count.careful_steps},
+                   {"substeps", t.count.substeps},
+                   {"contact_substeps", t.count.contact_substeps},
+                   {"rejected_substeps", t.count.rejected},
+                   {"events", t.count.events},
+                   {"substep_cap_hits", t.count.cap_hits},
+                   {"max_substeps_in_a_step", t.count.max_substeps_in_step}};
+  j["modal"] = modal_json(dev.info);
+  json dp = {{"floor", dev.info.device_floor}};
+  if (p.device.kind == DeviceKind::kTmd) {
+    const TmdDesign& d = dev.info.tmd;
+    dp.update({{"mass_kg", d.mass}, {"k_n_per_m", d.k}, {"c_ns_per_m", d.c}, {"mu", d.mu},
+               {"lambda", d.lambda}, {"xi", d.xi}, {"frequency_hz", d.omega / (2 * M_PI)}});
+  }
+  if (p.device.kind == DeviceKind::kVines) {
+    const VinesDesign& d = dev.info.vines;
+    dp.update({{"mass_kg", d.mass}, {"R_m", d.radius}, {"b_m", d.box_length}, {"gap_m", d.gap},
+               {"beta", d.box_length / (2 * d.radius)}, {"hertz_C", d.c}, {"eps", d.eps},
+               {"tau_s", d.tau}, {"v_ref_mps", d.v_ref}, {"reduced_mass_kg", d.m_star}});
+  }
+  if (has_device) j["device_params"] = dp;
+  j["wall_time_s"] = dev.wall_s;
+
+  if (!opt.out_dir.empty()) {
+    const fs::path dir(opt.out_dir);
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw std::runtime_error(opt.out_dir + ": cannot create: " + ec.message());
+    std::ofstream(dir / "summary.json") << j.dump(2) << '\n';
+    if (series) write_timeseries(dir / "timeseries.csv", scene, dev, has_device ? &bare : nullptr);
+  }
+  return j;
+}
+
+}  // namespace vines::host
