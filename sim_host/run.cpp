@@ -138,8 +138,13 @@ void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev
 
 Excitation load_excitation(const Scene& scene, const std::string& record_override) {
   hal::RecordSpec spec = scene.record;
-  if (!record_override.empty()) spec.path = record_override;
-  spec.path = resolve_record_path(spec.path, scene.path);
+  if (!record_override.empty()) {
+    if (!fs::is_regular_file(record_override))
+      throw std::runtime_error("--record " + record_override + ": no such file");
+    spec.path = record_override;
+  } else {
+    spec.path = resolve_record_path(spec.path, scene.path);
+  }
   Excitation ex;
   ex.record = hal::load_record(spec);
   if (scene.target_pga_mps2 > 0.0) {

@@ -6,6 +6,8 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
+bash tools/setup.sh
+
 cmake --preset release
 cmake --build --preset release -j2
 ctest --preset release

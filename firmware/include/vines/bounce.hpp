@@ -72,10 +72,14 @@ BounceResult bounce(const Law& law, double m, double v, double rtol = 1e-13) {
       out.ok = true;
       return out;
     }
+    // Deepest overlap: inside the step where the overlap rate changes sign.
+    if (y(1) >= 0.0 && r.y(1) <= 0.0) {
+      const double top = numeric::Cubic<double>::make(y(0), y(1), r.y(0), r.y(1), h).max_value();
+      if (top > out.max_overlap) out.max_overlap = top;
+    }
     t += h;
     y = r.y;
     f = r.f;
-    if (y(0) > out.max_overlap) out.max_overlap = y(0);
     h *= std::fmin(5.0, std::fmax(0.2, 0.9 * std::pow(std::fmax(en, 1e-10), -0.2)));
   }
   return out;
