@@ -69,13 +69,17 @@ Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex,
 
 json modal_json(const ModelInfo& in) {
   const int n = in.stories;
-  json mass_fraction = json::array();
-  for (int j = 0; j < n; ++j) mass_fraction.push_back(in.m_eff[j] / in.total_mass);
+  json mass_fraction = json::array(), shapes = json::array();
+  for (int j = 0; j < n; ++j) {
+    mass_fraction.push_back(in.m_eff[j] / in.total_mass);
+    shapes.push_back(head(in.mode_shapes[j], n));
+  }
   return {{"frequency_hz", head(in.frequency_hz, n)},
           {"damping_ratio", head(in.zeta, n)},
           {"effective_mass_kg", head(in.m_eff, n)},
           {"effective_mass_fraction", mass_fraction},
           {"participation_factor", head(in.gamma, n)},
+          {"mode_shapes", shapes},  // phi_j * gamma_j, bottom floor first (Table 1's normalisation)
           {"total_mass_kg", in.total_mass}};
 }
 

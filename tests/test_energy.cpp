@@ -23,6 +23,16 @@ TEST_P(Balance, ResidualBelow1e6) {
   if (law == ContactLaw::kHertz) EXPECT_LT(std::abs(l.contact), 1e-9 * l.input);
 }
 
+// A device need not sit on the top floor.
+TEST(BalanceOnAnotherFloor, VinesAndTmdOnFloorSix) {
+  for (DeviceKind kind : {DeviceKind::kVines, DeviceKind::kTmd}) {
+    SceneParams p = test::paper_scene(kind);
+    p.device.floor = 6;
+    const test::Outcome o = test::run(p, test::elcentro(1000.0));
+    EXPECT_LT(o.totals.ledger.relative_residual(), 1e-6);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     AllDevices, Balance,
     ::testing::Values(std::make_tuple(DeviceKind::kNone, ContactLaw::kKuwabara),

@@ -5,6 +5,9 @@
 //   TMD:               physical [x_1..x_N, x_d, v_1..v_N, v_d]     (one dense block)
 #pragma once
 
+#include <cmath>
+#include <limits>
+
 #include <Eigen/Core>
 
 #include "vines/devices.hpp"
@@ -49,6 +52,9 @@ struct DeviceModel<S, VinesDevice<L>> {
       law;
   // Error scales of the sub-stepper: a position and a speed typical of contacts.
   S pos_scale, vel_scale, modal_scale;
+  // Contacts shallower than this are not counted: the scene's depth, but no
+  // less than what the scalar resolves across the box (rounding fakes them).
+  S count_depth;
 };
 
 template <typename S, int N, typename Dev>
@@ -275,6 +281,8 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));
     dm.vel_scale = static_cast<S>(v_scale);
     dm.modal_scale = static_cast<S>(std::sqrt(md.frame.m.sum()));
+    const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
+    dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));
   }
   return {};
 }

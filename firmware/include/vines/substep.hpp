@@ -215,7 +215,7 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
       break;
     case Mode::kContactLeft:
     case Mode::kContactRight:
-      if (d.contact_depth > static_cast<S>(m.loop.contact_count_depth_m)) ++d.count.contacts;
+      if (d.contact_depth > m.dev.count_depth) ++d.count.contacts;
       st.mode = Mode::kFree;
       break;
     default:
