@@ -47,6 +47,7 @@ struct ModelInfo {
 struct RunTotals {
   FloorArray peak_x{}, peak_drift{};
   double peak_top = 0, t_peak_top = 0;
+  double peak_top_velocity = 0;
   double elastic_energy = 0, strain_increments = 0;
   double max_overlap = 0;
   Ledger ledger;

@@ -13,6 +13,7 @@ packages=(
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
   qemu-system-arm                                # runs the MCU image
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
+  openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
 )
 
 missing=()

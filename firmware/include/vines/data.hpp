@@ -69,6 +69,7 @@ struct Data {
   VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();
   S peak_top = S(0);
   double t_peak_top = 0;
+  S peak_top_velocity = S(0);  // largest |v| of the top floor at the samples
   double elastic_energy = 0;  // E_e = integral of (1/2) x^T K x dt [J s]
   double strain_increments = 0;  // sum of positive increments of the strain energy [J]
   double last_strain = 0;

@@ -94,6 +94,7 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   }
 
   // 3. Bookkeeping.
+  if (std::fabs(d.v(N - 1)) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(d.v(N - 1));
   ++d.k;
   ++d.count.steps;
   d.a_prev = a1;

@@ -1,0 +1,88 @@
+// `vines sweep`: grids of runs that differ from a base scene in a few keys,
+// spread over threads (and MPI ranks), with per-study statistics.
+//
+// A spec file holds one or more [[study]] tables:
+//   name     = "clearance"
+//   scene    = "../scenes/elcentro_vines.toml"   (relative to the spec)
+//   group_by = "vines.beta"     optional: statistics per value of this key
+//   optimize = "x_r"            optional: "x_r" or "E_r", report the best value
+//                               of group_by (by mean) or of the single grid key
+//   [study.set]   "key" = value                   fixed overrides of scene keys
+//   [[study.cases]] "key" = value, ...            paired overrides, one case each
+//   [study.grid]  "key" = [values] | {from, to, step | count, scale}
+//                 or a list of such tables (their union); scale = "gap" (the
+//                 VI NES free travel) or "vmax" (the bare frame's peak top
+//                 velocity) multiplies the values; a value "unset" removes
+//                 the key from the scene.
+// Runs are the product cases x grid; each is the scene with its keys set. A
+// run's x_r and E_r compare it with the bare frame on the same record.
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace vines::host {
+
+struct SweepOptions {
+  std::string out_dir;  // "" = out/<spec stem>
+  int threads = 0;      // 0 = all cores
+  bool progress = true;
+};
+
+// One value of a scene key: a number (integral if it came as an integer), a
+// string, or "unset".
+struct KeyValue {
+  std::string key;
+  double number = 0;
+  bool integral = false;
+  std::string text;  // a string value ("unset" removes the key), or "scale:gap"/"scale:vmax"
+  std::string label() const;   // the value as written in results.csv
+  std::string column() const;  // its results.csv column: the key, "/gap" or "/vmax" when scaled
+  bool scaled() const { return text.rfind("scale:", 0) == 0; }
+};
+
+struct RunPlan {
+  int study = 0;
+  std::vector<KeyValue> values;  // cases and grid, in column order
+};
+
+struct RunResult {
+  bool done = false;
+  std::string error;  // non-empty: the run was refused or failed
+  std::string device;
+  double x_r = 0, E_r = 0, peak_top = 0, elastic_energy = 0, residual = 0;
+  long long contacts = 0, cap_hits = 0;
+};
+
+struct StudySpec {
+  std::string name, scene_path, group_by, optimize;
+  std::vector<KeyValue> set;
+  std::vector<std::vector<KeyValue>> cases;
+  std::vector<std::vector<KeyValue>> grid_axes;  // one list of values per key
+};
+
+struct SweepSpec {
+  std::string path;
+  std::vector<StudySpec> studies;
+};
+
+SweepSpec load_sweep(const std::string& path);
+
+// Every run of the spec, in a fixed order (results are indexed by it).
+std::vector<RunPlan> plan_runs(const SweepSpec& spec);
+
+// Runs plan[i] for every i with i % stride == offset (others stay not done),
+// on `threads` threads; stops taking new runs once *stop is set.
+std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
+                               int offset, int stride, const std::atomic<bool>* stop,
+                               bool progress);
+
+// results.csv and summary.json of a (possibly partial) result set; returns the summary.
+nlohmann::json write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
+                           const std::vector<RunResult>& results, const std::string& out_dir,
+                           double wall_s);
+
+}  // namespace vines::host
