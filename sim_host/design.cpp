@@ -1,0 +1,106 @@
+#include "sim_host/design.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "sim_host/sweep.hpp"
+
+namespace vines::host {
+namespace {
+
+using nlohmann::json;
+
+// Objective of each value: the metric over the records, averaged or worst.
+std::vector<double> evaluate(const DesignOptions& opt, const std::vector<double>& values) {
+  SweepSpec spec;
+  spec.path = opt.scene_path;
+  StudySpec st;
+  st.name = "design";
+  st.scene_path = opt.scene_path;
+  for (const std::string& r : opt.records) {
+    KeyValue path{"record.path", 0, false, r}, format{"record.format", 0, false, "auto"};
+    st.cases.push_back({path, format});
+  }
+  std::vector<KeyValue> axis;
+  for (double v : values) axis.push_back(KeyValue{opt.key, v, false, ""});
+  st.grid_axes.push_back(axis);
+  spec.studies.push_back(st);
+  const std::vector<RunPlan> plan = plan_runs(spec);
+  const std::vector<RunResult> res = execute(spec, plan, opt.threads, 0, 1, nullptr, false);
+  std::vector<double> out(values.size(), 0.0);
+  std::vector<int> count(values.size(), 0);
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    if (!res[i].error.empty()) throw std::runtime_error(res[i].error);
+    const std::size_t j = i % values.size();  // cases outer, grid inner
+    const double m = opt.metric == "E_r" ? res[i].E_r : res[i].x_r;
+    out[j] = opt.objective == "worst" ? (count[j] ? std::min(out[j], m) : m) : out[j] + m;
+    ++count[j];
+  }
+  if (opt.objective != "worst")
+    for (std::size_t j = 0; j < out.size(); ++j) out[j] /= count[j];
+  return out;
+}
+
+}  // namespace
+
+bool design_parameter(const std::string& name, DesignOptions* opt) {
+  static const std::map<std::string, std::pair<std::string, std::pair<double, double>>> kKnown = {
+      {"beta", {"vines.beta", {1.05, 2.0}}},
+      {"eps", {"vines.eps", {0.1, 1.0}}},
+      {"mass_ratio", {"device.mass_ratio", {0.01, 0.2}}}};
+  const auto it = kKnown.find(name);
+  if (it != kKnown.end()) {
+    opt->key = it->second.first;
+    if (opt->lo == opt->hi) std::tie(opt->lo, opt->hi) = it->second.second;
+    return true;
+  }
+  if (name.find('.') == std::string::npos) return false;
+  opt->key = name;
+  return opt->lo < opt->hi;  // a raw key needs --range
+}
+
+json optimize_design(const DesignOptions& opt) {
+  json evals = json::array();
+  auto record = [&](const std::vector<double>& v, const std::vector<double>& f, const char* phase) {
+    for (std::size_t i = 0; i < v.size(); ++i) evals.push_back({{"value", v[i]}, {"objective", f[i]}, {"phase", phase}});
+  };
+  // Coarse grid.
+  std::vector<double> grid;
+  for (int i = 0; i < opt.coarse; ++i) grid.push_back(opt.lo + (opt.hi - opt.lo) * i / (opt.coarse - 1));
+  const std::vector<double> fg = evaluate(opt, grid);
+  record(grid, fg, "grid");
+  const std::size_t b = static_cast<std::size_t>(std::max_element(fg.begin(), fg.end()) - fg.begin());
+  double best_x = grid[b], best_f = fg[b];
+  // Golden section on the bracket [grid[b-1], grid[b+1]].
+  double a = grid[b > 0 ? b - 1 : 0], c = grid[std::min(b + 1, grid.size() - 1)];
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double x1 = c - g * (c - a), x2 = a + g * (c - a);
+  std::vector<double> f12 = evaluate(opt, {x1, x2});
+  record({x1, x2}, f12, "refine");
+  double f1 = f12[0], f2 = f12[1];
+  for (int it = 0; it < opt.refine; ++it) {
+    if (f1 >= f2) {
+      c = x2; x2 = x1; f2 = f1;
+      x1 = c - g * (c - a);
+      f1 = evaluate(opt, {x1})[0];
+      record({x1}, {f1}, "refine");
+    } else {
+      a = x1; x1 = x2; f1 = f2;
+      x2 = a + g * (c - a);
+      f2 = evaluate(opt, {x2})[0];
+      record({x2}, {f2}, "refine");
+    }
+  }
+  for (const auto& e : evals)
+    if (e["objective"].get<double>() > best_f) {
+      best_f = e["objective"];
+      best_x = e["value"];
+    }
+  return {{"scene", opt.scene_path}, {"key", opt.key}, {"metric", opt.metric}, {"objective", opt.objective},
+          {"records", opt.records}, {"range", {opt.lo, opt.hi}},
+          {"best", {{"value", best_x}, {"objective", best_f}}}, {"evaluations", evals}};
+}
+
+}  // namespace vines::host

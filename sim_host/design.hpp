@@ -1,0 +1,32 @@
+// `vines design`: the best value of one design parameter of a scene, for one
+// record or robustly over several (mean or worst case of x_r or E_r): a coarse
+// grid, then golden-section refinement of the bracket around the grid's best.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace vines::host {
+
+struct DesignOptions {
+  std::string scene_path;
+  std::string key;                   // scene key, e.g. "vines.beta"
+  double lo = 0, hi = 0;             // search range
+  int coarse = 21;                   // coarse grid points
+  int refine = 12;                   // golden-section iterations
+  std::vector<std::string> records;  // empty: the scene's record
+  std::string objective = "mean";    // "mean" or "worst" over the records
+  std::string metric = "x_r";        // "x_r" or "E_r"
+  int threads = 0;
+};
+
+// Shorthands for --optimize: beta, eps, mass_ratio; anything with a dot is a
+// scene key. Fills key and the default range; false if unknown.
+bool design_parameter(const std::string& name, DesignOptions* opt);
+
+// Runs the search; returns {best: {value, objective}, evaluations: [...]}.
+nlohmann::json optimize_design(const DesignOptions& opt);
+
+}  // namespace vines::host

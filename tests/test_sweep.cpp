@@ -1,0 +1,172 @@
+// The paper's studies through `vines sweep` specs (data/studies/), checked
+// against its published figures, and the sweep machinery itself.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "sim_host/design.hpp"
+#include "sim_host/sweep.hpp"
+
+namespace {
+
+using namespace vines::host;
+namespace fs = std::filesystem;
+
+std::string study_file(const std::string& name) {
+  return std::string(VINES_SOURCE_DIR) + "/data/studies/" + name;
+}
+
+// Runs the named studies of a spec (all if none named) on 2 threads.
+struct Sweep {
+  SweepSpec spec;
+  std::vector<RunPlan> plan;
+  std::vector<RunResult> results;
+  Sweep(const std::string& file, std::vector<std::string> only = {}, int threads = 2) {
+    spec = load_sweep(study_file(file));
+    if (!only.empty()) {
+      std::vector<StudySpec> kept;
+      for (const StudySpec& s : spec.studies)
+        if (std::find(only.begin(), only.end(), s.name) != only.end()) kept.push_back(s);
+      spec.studies = kept;
+    }
+    plan = plan_runs(spec);
+    results = execute(spec, plan, threads, 0, 1, nullptr, false);
+  }
+  // (value of `key`, result) for the runs of study s.
+  std::vector<std::pair<double, RunResult>> by(int s, const std::string& key) const {
+    std::vector<std::pair<double, RunResult>> out;
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      if (plan[i].study != s) continue;
+      EXPECT_TRUE(results[i].error.empty()) << results[i].error;
+      double v = NAN;
+      for (const KeyValue& kv : plan[i].values)
+        if (kv.key == key) v = kv.number;
+      out.emplace_back(v, results[i]);
+    }
+    return out;
+  }
+};
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+double sd(const std::vector<double>& v) {
+  const double m = mean(v);
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+TEST(Studies, ClearanceOptimumAndTmdReference) {
+  const Sweep sw("clearance.toml");
+  double best_beta = 0, best = -1;
+  for (const auto& [beta, r] : sw.by(0, "vines.beta"))
+    if (r.x_r > best) { best = r.x_r; best_beta = beta; }
+  const double tmd = sw.by(1, "").front().second.x_r;
+  EXPECT_GE(best_beta, 1.30);
+  EXPECT_LE(best_beta, 1.40);
+  EXPECT_GT(best, tmd);
+  EXPECT_NEAR(tmd, 0.131, 0.01);
+}
+
+TEST(Studies, InitialConditionGridMatchesTable2) {
+  const Sweep sw("initial_conditions.toml", {"ic_vines"});
+  ASSERT_EQ(sw.plan.size(), 33u * 33u);
+  std::vector<double> xr, er;
+  for (const auto& [v, r] : sw.by(0, "")) {
+    xr.push_back(r.x_r);
+    er.push_back(r.E_r);
+  }
+  EXPECT_NEAR(mean(xr), 0.260, 0.02);
+  EXPECT_NEAR(sd(xr), 0.043, 0.015);
+  EXPECT_NEAR(mean(er), 0.605, 0.03);
+}
+
+TEST(Studies, DamageHurtsTheTmdNotTheVines) {
+  const Sweep sw("damage.toml");
+  bool tmd_negative = false;
+  for (const auto& [eta, r] : sw.by(1, "frame.stiffness_scale"))
+    if (eta >= 0.85 - 1e-9 && eta <= 0.95 + 1e-9 && r.x_r < 0) tmd_negative = true;
+  EXPECT_TRUE(tmd_negative);
+  const auto vines = sw.by(0, "frame.stiffness_scale");
+  EXPECT_EQ(vines.size(), 31u);
+  for (const auto& [eta, r] : vines) EXPECT_GT(r.x_r, 0.0) << "eta_k " << eta;
+}
+
+TEST(Design, FindsTheClearanceOptimumByGridAndGoldenSection) {
+  DesignOptions opt;
+  opt.scene_path = std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml";
+  ASSERT_TRUE(design_parameter("beta", &opt));
+  EXPECT_EQ(opt.key, "vines.beta");
+  const auto j = optimize_design(opt);
+  const double beta = j["best"]["value"], xr = j["best"]["objective"];
+  EXPECT_GE(beta, 1.30);
+  EXPECT_LE(beta, 1.40);
+  // Refinement never loses the grid's best.
+  double grid_best = -1;
+  for (const auto& e : j["evaluations"])
+    if (e["phase"] == "grid") grid_best = std::max(grid_best, e["objective"].get<double>());
+  EXPECT_GE(xr, grid_best);
+  EXPECT_GT(xr, 0.25);
+}
+
+TEST(Sweep, ResultsDoNotDependOnTheThreadCount) {
+  const Sweep one("clearance.toml", {"clearance_vines"}, 1);
+  const Sweep two("clearance.toml", {"clearance_vines"}, 2);
+  ASSERT_EQ(one.results.size(), two.results.size());
+  for (std::size_t i = 0; i < one.results.size(); ++i) {
+    EXPECT_EQ(one.results[i].x_r, two.results[i].x_r) << i;
+    EXPECT_EQ(one.results[i].E_r, two.results[i].E_r) << i;
+    EXPECT_EQ(one.results[i].contacts, two.results[i].contacts) << i;
+  }
+}
+
+TEST(Sweep, EveryRecordRunsForBothDevices) {
+  const Sweep sw("records.toml");
+  EXPECT_EQ(sw.plan.size(), 40u);
+  for (const RunResult& r : sw.results) {
+    EXPECT_TRUE(r.error.empty()) << r.error;
+    EXPECT_LT(r.residual, 1e-6);
+    EXPECT_EQ(r.cap_hits, 0);
+  }
+}
+
+TEST(Sweep, BadSpecsAreRefusedWithTheirKey) {
+  const fs::path dir = fs::temp_directory_path() / ("vines_sweep_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto refused = [&](const std::string& text, const std::string& needle) {
+    const fs::path f = dir / "spec.toml";
+    std::ofstream(f) << text;
+    try {
+      const SweepSpec s = load_sweep(f.string());
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  const std::string scene = "scene = \"" + std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml\"\n";
+  refused("[[study]]\nname = \"a\"\n", "needs scene");
+  refused("[[study]]\n" + scene + "bogus = 1\n", "unknown key 'bogus'");
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.beta\" = { from = 1, to = 2 }\n", "needs 'step' or 'count'");
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.beta\" = { from = 1, to = 2, step = 0.1, scale = \"x\" }\n", "scale");
+  refused("[[study]]\n" + scene + "optimize = \"speed\"\n", "optimize");
+  refused("[[study]]\n" + scene + "group_by = \"vines.eps\"\n", "group_by");
+  refused("[study\n", "TOML syntax error");
+  // A grid value the scene refuses fails that run with the scene's message.
+  const fs::path f = dir / "bad_beta.toml";
+  std::ofstream(f) << "[[study]]\n" << scene << "[study.grid]\n\"vines.beta\" = [0.9, 1.35]\n";
+  SweepSpec spec = load_sweep(f.string());
+  const auto plan = plan_runs(spec);
+  const auto res = execute(spec, plan, 1, 0, 1, nullptr, false);
+  EXPECT_NE(res[0].error.find("vines.beta"), std::string::npos) << res[0].error;
+  EXPECT_TRUE(res[1].error.empty());
+  fs::remove_all(dir);
+}
+
+}  // namespace
