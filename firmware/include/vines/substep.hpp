@@ -25,6 +25,16 @@ namespace vines {
 // and the particle rides the wall (no Zeno cascade of ever smaller bounces).
 inline constexpr double kStickSpeed = 1e-6;
 
+// Overlaps below this [m] do not start a contact: rounding makes them when the
+// particle rests against a wall, and chasing them only churns events.
+template <typename S, int N, typename Dev>
+S event_tolerance(const Model<S, N, Dev>& m) {
+  const auto& dm = m.dev;
+  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
+  return std::fmax(rtol * dm.pos_scale * S(1e-2),
+                   S(64) * std::numeric_limits<S>::epsilon() * (dm.wall_right - dm.wall_left));
+}
+
 // Overlap with the left and right walls for a relative position r = s - x_f
 // (positive means interpenetration).
 template <typename S, typename DM>
@@ -231,11 +241,11 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   const auto& dm = m.dev;
-  const S r = st.rel_pos(y), rd = st.rel_vel(y);
+  const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = event_tolerance(m);
   switch (st.mode) {
     case Mode::kFree:
-      if (overlap_left<S>(dm, r) > S(0) && rd < S(0)) return -1;
-      if (overlap_right<S>(dm, r) > S(0) && rd > S(0)) return 1;
+      if (overlap_left<S>(dm, r) > tol && rd < S(0)) return -1;
+      if (overlap_right<S>(dm, r) > tol && rd > S(0)) return 1;
       return 0;
     case Mode::kContactLeft:
       return overlap_left<S>(dm, r) < S(0) || (overlap_left<S>(dm, r) == S(0) && rd > S(0)) ? -1 : 0;
@@ -244,8 +254,10 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
     default: {
       S fp, loss;
       st.force(y, S(0), &fp, &loss);
+      // Leave once the wall would have to pull (beyond rounding: 1e-9 m/s^2).
       const bool left = st.mode == Mode::kStuckLeft;
-      return (left && fp < S(0)) || (!left && fp > S(0)) ? (left ? -1 : 1) : 0;
+      const S pull = (left ? -fp : fp) * m.dev.inv_m;
+      return pull > S(1e-9) ? (left ? -1 : 1) : 0;
     }
   }
 }
@@ -261,9 +273,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   // Tolerances that the scalar can honour.
   const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol),
                            S(64) * std::numeric_limits<S>::epsilon());
-  const S event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2),
-                                S(64) * std::numeric_limits<S>::epsilon() *
-                                    (dm.wall_right - dm.wall_left));
+  const S event_tol = event_tolerance(m);
   const int cap = m.loop.max_substeps_per_step;
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
@@ -283,9 +293,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     (void)ff;
     const S r = st.rel_pos(yy), rd = st.rel_vel(yy);
     switch (st.mode) {
-      case Mode::kFree:  // overlap with wall `side` becomes positive
+      case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
         *slope = side < 0 ? -rd : rd;
-        return side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
+        return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - event_tol;
       case Mode::kContactLeft:  // overlap returns to zero
         *slope = rd;
         return -overlap_left<S>(dm, r);
@@ -327,10 +337,11 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
     if (forced) capped = true;
 
-    // Does an event happen inside this sub-step? Which side first?
+    // Does an event happen inside this sub-step? Which side first? (Not in a
+    // forced sub-step: past the cap, events wait for the next step.)
     S theta = S(2);
     int side = 0;
-    for (int sd = -1; sd <= 1; sd += 2) {
+    for (int sd = -1; sd <= 1 && !forced; sd += 2) {
       if (st.mode != Mode::kFree && sd == 1) break;
       S s0, s1;
       const S g0 = event_value(y, f, sd, &s0), g1 = event_value(r.y, r.f, sd, &s1);
