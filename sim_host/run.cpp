@@ -223,7 +223,9 @@ json run_scene(const Scene& scene, const RunOptions& opt) {
                    {"rejected_substeps", t.count.rejected},
                    {"events", t.count.events},
                    {"substep_cap_hits", t.count.cap_hits},
-                   {"max_substeps_in_a_step", t.count.max_substeps_in_step}};
+                   {"max_substeps_in_a_step", t.count.max_substeps_in_step},
+                   {"bad_samples_held", t.count.bad_samples},
+                   {"divergences_rolled_back", t.count.divergences}};
   j["modal"] = modal_json(dev.info);
   json dp = {{"floor", dev.info.device_floor}};
   if (p.device.kind == DeviceKind::kTmd) {

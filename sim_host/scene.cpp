@@ -24,7 +24,8 @@
 //             there), column (1-based, not with at2 / accel),
 //             scale | pga_g (not both), duration_s
 //   [loop]    sensor_rate_hz, contact_rtol, max_substeps_per_step,
-//             contact_count_depth_m, energy_ledger, scalar = "double" | "float"
+//             contact_count_depth_m, energy_ledger, divergence_limit_m,
+//             scalar = "double" | "float"
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
 //
 // Rules:
@@ -379,6 +380,7 @@ void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
   s.read("max_substeps_per_step", &l->max_substeps_per_step);
   s.read("contact_count_depth_m", &l->contact_count_depth_m);
   s.read("energy_ledger", &l->energy_ledger);
+  s.read("divergence_limit_m", &l->divergence_limit_m);
   s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}}, scalar);
 }
 
@@ -460,7 +462,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   read_record(record, &scene);
   read_loop(Section(origin, root, "loop",
                     {"sensor_rate_hz", "contact_rtol", "max_substeps_per_step",
-                     "contact_count_depth_m", "energy_ledger", "scalar"}),
+                     "contact_count_depth_m", "energy_ledger", "divergence_limit_m", "scalar"}),
             &p.loop, &scene.scalar);
 
   // The shared range checks, reported at the offending key's line.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "support.hpp"
 
@@ -30,6 +31,41 @@ TEST(Loop, FreeFlightStepsAreNotSubstepped) {
   EXPECT_EQ(o.totals.count.steps, 53760);
   EXPECT_LT(o.totals.count.careful_steps, 0.02 * 53760);
   EXPECT_GT(o.totals.count.contact_substeps, 18);
+}
+
+TEST(Loop, NonFiniteSamplesAreHeldAndCounted) {
+  for (DeviceKind kind : {DeviceKind::kNone, DeviceKind::kTmd, DeviceKind::kVines}) {
+    std::vector<double> a = test::elcentro(1000.0);
+    a.resize(8001);
+    a[1000] = NAN;
+    a[2000] = INFINITY;
+    a[2001] = -INFINITY;
+    const test::Outcome o = test::run(test::paper_scene(kind), a);
+    EXPECT_EQ(o.totals.count.bad_samples, 3);
+    EXPECT_EQ(o.totals.count.divergences, 0);
+    EXPECT_TRUE(std::isfinite(o.totals.peak_top));
+    EXPECT_TRUE(std::isfinite(o.last.x[9]));
+    // Holding a sample for a millisecond barely moves the response.
+    std::vector<double> clean = test::elcentro(1000.0);
+    clean.resize(8001);
+    EXPECT_NEAR(o.last.x[9], test::run(test::paper_scene(kind), clean).last.x[9], 1e-3);
+  }
+}
+
+TEST(Loop, DivergingStepsAreRolledBack) {
+  // A finite but absurd sample (1e200 m/s^2) blows the state up: the guard
+  // rolls those steps back, the run goes on with the last good state.
+  for (DeviceKind kind : {DeviceKind::kNone, DeviceKind::kTmd, DeviceKind::kVines}) {
+    std::vector<double> a = test::elcentro(1000.0);
+    a.resize(4001);
+    a[3000] = 1e200;
+    const test::Outcome o = test::run(test::paper_scene(kind), a);
+    EXPECT_GE(o.totals.count.divergences, 1);
+    EXPECT_TRUE(std::isfinite(o.last.x[9]));
+    EXPECT_LT(std::abs(o.last.x[9]), 1.0);
+    EXPECT_LT(o.totals.peak_top, 1.0);
+    EXPECT_LT(o.totals.ledger.relative_residual(), 1e-3);
+  }
 }
 
 TEST(Loop, RestitutionLawLocatesImpactsAndBalancesEnergy) {

@@ -43,6 +43,8 @@ struct Counters {
   std::int64_t contacts = 0;          // contacts deeper than the counting depth
   std::int64_t cap_hits = 0;          // steps that hit the sub-step cap
   std::int64_t max_substeps_in_step = 0;
+  std::int64_t bad_samples = 0;   // non-finite ground samples, replaced by the last good one
+  std::int64_t divergences = 0;   // steps rolled back by the divergence guard
 };
 
 template <typename S, int N, typename Dev>

@@ -94,6 +94,9 @@ struct LoopParams {
   // Contacts shallower than this are not counted (rounding at rest contact).
   double contact_count_depth_m = 1e-9;
   bool energy_ledger = true;
+  // Divergence guard: a floor (or the TMD) farther than this from the ground
+  // [m], or any non-finite state, rolls the step back (see sim.hpp).
+  double divergence_limit_m = 100.0;
 };
 
 struct SceneParams {

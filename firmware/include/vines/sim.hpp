@@ -64,11 +64,42 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
   d.last_strain = static_cast<double>(m.strain.eval(d.z, S(0)));
 }
 
+namespace detail {
+
+// Divergence check (MuJoCo-style warning): any non-finite state, a floor or
+// the TMD beyond the model's limit, or a particle beyond a wall by more than
+// its radius.
+template <typename S, int N, typename Dev>
+bool diverged(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  if (!d.z.allFinite() || !(d.x.cwiseAbs().maxCoeff() <= limit)) return true;
+  if constexpr (Dev::kKind == DeviceKind::kTmd) {
+    if (!(std::fabs(d.z(N)) <= limit)) return true;
+  }
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    const S r = d.s - d.x(m.floor), radius = static_cast<S>(m.dev.design.radius);
+    if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(d.sd))
+      return true;
+  }
+  return false;
+}
+
+}  // namespace detail
+
 // Advances the run by one sensor period to the next sample a1 [m/s^2].
+// Guards: a non-finite sample is replaced by the last good one (hold) and
+// counted; a step that diverges is rolled back to the state before it (the
+// model holds its last good state, the clock advances) and counted. Both
+// counters are outputs; neither stops the loop.
 template <typename S, int N, typename Dev>
 void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   using VecX = typename Model<S, N, Dev>::VecX;
+  if (!std::isfinite(a1)) {
+    ++d.count.bad_samples;
+    a1 = d.a_prev;
+  }
   const S a0 = d.a_prev;
+  const Data<S, N, Dev> before = d;
   const VecX z0 = d.z;
   const typename Model<S, N, Dev>::VecN x0 = d.x, v0 = d.v;
 
@@ -91,6 +122,13 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   } else {
     // 2. Sub-stepped step through (possible) contacts.
     if constexpr (Dev::kKind == DeviceKind::kVines) substep_through(m, d, a0, a1);
+  }
+
+  if (detail::diverged(m, d)) {
+    const Counters count = d.count;
+    d = before;
+    d.count = count;
+    ++d.count.divergences;
   }
 
   // 3. Bookkeeping.

@@ -114,6 +114,8 @@ inline ParamError validate(const LoopParams& l) {
     return {"loop.max_substeps_per_step", "must be in [1, 1e6]"};
   if (!(std::isfinite(l.contact_count_depth_m) && l.contact_count_depth_m >= 0.0))
     return {"loop.contact_count_depth_m", "must be >= 0"};
+  if (!(std::isfinite(l.divergence_limit_m) && l.divergence_limit_m > 0.0))
+    return {"loop.divergence_limit_m", "must be finite and > 0"};
   return {};
 }
 
