@@ -365,9 +365,14 @@ SweepSpec load_sweep(const std::string& path) {
           for (KeyValue& v : ax.values) v.text = "scale:" + ax.scale;
         st.grid_axes.push_back(ax.values);
       }
-    for (const auto* group : {&st.set})
-      for (const KeyValue& v : *group)
-        if (v.key.find('.') == std::string::npos) fail(where, v.key + ": keys are table.key");
+    // Every key this study sets (fixed, per case, per grid axis) is a scene key.
+    auto check_key = [&](const KeyValue& v) {
+      if (v.key.find('.') == std::string::npos) fail(where, v.key + ": keys are table.key");
+    };
+    for (const KeyValue& v : st.set) check_key(v);
+    for (const auto& c : st.cases)
+      for (const KeyValue& v : c) check_key(v);
+    for (const auto& ax : st.grid_axes) check_key(ax.front());
     if (!st.group_by.empty()) {
       bool found = false;
       for (const auto& ax : st.grid_axes) found |= ax.front().key == st.group_by;
@@ -493,14 +498,15 @@ json write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
     std::map<double, std::pair<std::vector<double>, std::vector<double>>> groups;
     std::map<double, std::string> group_labels;
     std::string device;
+    // Statistics per value of group_by, or of the single grid key when optimising.
+    const std::string gkey = !st.group_by.empty() ? st.group_by
+                             : (!st.optimize.empty() && st.grid_axes.size() == 1) ? st.grid_axes[0].front().key
+                                                                                    : "";
     for (std::size_t i = 0; i < plan.size(); ++i) {
       if (plan[i].study != s || !results[i].done || !results[i].error.empty()) continue;
       xr.push_back(results[i].x_r);
       er.push_back(results[i].E_r);
       device = results[i].device;
-      const std::string gkey = !st.group_by.empty() ? st.group_by
-                               : (!st.optimize.empty() && st.grid_axes.size() == 1) ? st.grid_axes[0].front().key
-                                                                                      : "";
       for (const KeyValue& v : plan[i].values)
         if (v.key == gkey) {
           groups[v.number].first.push_back(results[i].x_r);
@@ -511,7 +517,6 @@ json write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
     json js = {{"name", st.name}, {"scene", st.scene_path}, {"device", device}, {"runs", xr.size()},
                {"x_r", stats(xr)}, {"E_r", stats(er)}};
     if (!groups.empty()) {
-      const std::string gkey = !st.group_by.empty() ? st.group_by : st.grid_axes[0].front().key;
       json jg = json::array();
       double best_value = 0, best = -1e300;
       for (auto& [value, g] : groups) {

@@ -158,6 +158,8 @@ TEST(Sweep, BadSpecsAreRefusedWithTheirKey) {
   refused("[[study]]\n" + scene + "optimize = \"speed\"\n", "optimize");
   refused("[[study]]\n" + scene + "group_by = \"vines.eps\"\n", "group_by");
   refused("[study\n", "TOML syntax error");
+  refused("[[study]]\n" + scene + "[study.grid]\nbeta = [1.2]\n", "keys are table.key");
+  refused("[[study]]\n" + scene + "[[study.cases]]\npath = \"x\"\n", "keys are table.key");
   // A grid value the scene refuses fails that run with the scene's message.
   const fs::path f = dir / "bad_beta.toml";
   std::ofstream(f) << "[[study]]\n" << scene << "[study.grid]\n\"vines.beta\" = [0.9, 1.35]\n";
