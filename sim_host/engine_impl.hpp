@@ -44,9 +44,10 @@ class EngineImpl final : public Engine {
     s.t = d.time(m);
     s.ag = static_cast<double>(d.a_prev);
     const auto acc = absolute_accel(m, d);
+    const auto x = floor_displacements(m, d), v = floor_velocities(m, d);
     for (int i = 0; i < N; ++i) {
-      s.x[i] = static_cast<double>(d.x(i));
-      s.v[i] = static_cast<double>(d.v(i));
+      s.x[i] = static_cast<double>(x(i));
+      s.v[i] = static_cast<double>(v(i));
       s.acc[i] = static_cast<double>(acc(i));
       s.drift[i] = s.x[i] - (i ? s.x[i - 1] : 0.0);
     }

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "sim_host/bench.hpp"
 #include "sim_host/design.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
@@ -38,6 +39,9 @@ constexpr const char* kUsage =
     "  design SCENE.toml --optimize beta|eps|mass_ratio|TABLE.KEY [options]\n"
     "      Best value of one design parameter for the scene's record or a set of\n"
     "      records (mean or worst case): coarse grid, then golden-section refinement.\n"
+    "  bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST] [--json]\n"
+    "      Speed against accuracy: wall time of full runs and their error against the\n"
+    "      converged reference (data/reference), per sensor rate, tolerance and scalar.\n"
     "  help [COMMAND]\n"
     "      This text.\n"
     "\n"
@@ -78,6 +82,22 @@ constexpr const char* kDesignUsage =
     "  --metric          x_r (default) or E_r, maximised\n"
     "  --coarse N        coarse grid points (default 21); --refine N golden steps (12)\n"
     "  --out DIR         writes DIR/design.json (default: out/design_<scene name>)\n";
+
+constexpr const char* kBenchUsage =
+    "usage: vines bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
+    "                   [--min-time S] [--reference DIR] [--full-outputs] [--json] [--csv FILE]\n"
+    "\n"
+    "  Times full runs of each scene (record loaded, model built; median of repeats)\n"
+    "  and compares them with the scene's reference (DIR/<scene name>.json, default\n"
+    "  data/reference, written by `vines reference`).\n"
+    "  --rates LIST    sensor rates [Hz], comma-separated (default: the scene's)\n"
+    "  --rtols LIST    contact sub-step tolerances (default: the scene's)\n"
+    "  --scalars LIST  double,float (default: the scene's scalar)\n"
+    "  --min-time S    time each line for at least S seconds (default 0.3)\n"
+    "  --full-outputs  also compute the scene's per-floor peaks and energy ledger\n"
+    "                  (default: only what the table needs, as a study run does)\n"
+    "  --json          print JSON: one object for a single line, else {\"lines\": [...]}\n"
+    "  --csv FILE      also write the lines as CSV\n";
 
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
@@ -211,6 +231,107 @@ int cmd_design(const std::vector<std::string>& args) {
   }
 }
 
+// "a,b,c" -> numbers; false if any item is not a finite number > 0.
+bool number_list(const std::string& v, std::vector<double>* out) {
+  std::size_t start = 0;
+  while (start <= v.size()) {
+    const std::size_t comma = v.find(',', start);
+    const std::string item = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0)) return false;
+    out->push_back(x);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return !out->empty();
+}
+
+int cmd_bench(const std::vector<std::string>& args) {
+  using namespace vines::host;
+  std::vector<std::string> scenes;
+  BenchOptions opt;
+  bool as_json = false;
+  std::string csv;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kBenchUsage, stdout);
+      return 0;
+    }
+    if (a == "--json" || a == "--full-outputs") {
+      (a == "--json" ? as_json : opt.full_outputs) = true;
+      continue;
+    }
+    if (a.empty() || a[0] != '-') {
+      scenes.push_back(a);
+      continue;
+    }
+    if (i + 1 >= args.size()) return usage_error(kBenchUsage, a + " needs a value");
+    const std::string& v = args[++i];
+    std::vector<double> xs;
+    if (a == "--rates" || a == "--rtols" || a == "--min-time") {
+      if (!number_list(v, &xs)) return usage_error(kBenchUsage, a + ": not a list of positive numbers: " + v);
+      if (a == "--rates") opt.rates_hz = xs;
+      else if (a == "--rtols") opt.rtols = xs;
+      else opt.min_time_s = xs[0];
+    } else if (a == "--scalars") {
+      for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
+        c = v.find(',', s);
+        if (c == std::string::npos) c = v.size();
+        opt.scalars.push_back(v.substr(s, c - s));
+      }
+    } else if (a == "--reference") {
+      opt.reference_dir = v;
+    } else if (a == "--csv") {
+      csv = v;
+    } else {
+      return usage_error(kBenchUsage, "unknown option " + a);
+    }
+  }
+  if (scenes.empty()) return usage_error(kBenchUsage, "no scene given");
+  try {
+    std::vector<BenchLine> lines;
+    for (const std::string& path : scenes) {
+      const Scene scene = load_scene(path);
+      BenchOptions o = opt;
+      if (o.scalars.empty()) o.scalars = {scalar_name(scene.scalar)};
+      const std::vector<BenchLine> ls = bench_scene(scene, o);
+      lines.insert(lines.end(), ls.begin(), ls.end());
+      if (!as_json) std::fputs(format_table(ls).c_str(), stdout);
+    }
+    if (!csv.empty()) {
+      std::ofstream out(csv);
+      if (!out) throw std::runtime_error(csv + ": cannot write");
+      bool header = true;
+      for (const BenchLine& l : lines) {
+        const nlohmann::json j = line_json(l);
+        if (header) {
+          for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.key();
+          out << '\n';
+          header = false;
+        }
+        for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.value().dump();
+        out << '\n';
+      }
+    }
+    if (as_json) {
+      nlohmann::json j;
+      if (lines.size() == 1) {
+        j = line_json(lines[0]);
+      } else {
+        j["lines"] = nlohmann::json::array();
+        for (const BenchLine& l : lines) j["lines"].push_back(line_json(l));
+      }
+      std::printf("%s\n", j.dump(2).c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vines bench: %s\n", e.what());
+    return 1;
+  }
+}
+
 std::atomic<bool> g_stop{false};
 
 int cmd_sweep(const std::vector<std::string>& args) {
@@ -296,10 +417,12 @@ int main(int argc, char** argv) {
   if (cmd == "run") return cmd_run(args);
   if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "design") return cmd_design(args);
+  if (cmd == "bench") return cmd_bench(args);
   if (cmd == "help" || cmd == "-h" || cmd == "--help") {
     if (!args.empty() && args[0] == "run") std::fputs(kRunUsage, stdout);
     else if (!args.empty() && args[0] == "sweep") std::fputs(kSweepUsage, stdout);
     else if (!args.empty() && args[0] == "design") std::fputs(kDesignUsage, stdout);
+    else if (!args.empty() && args[0] == "bench") std::fputs(kBenchUsage, stdout);
     else std::fputs(kUsage, stdout);
     return 0;
   }

@@ -24,7 +24,8 @@
 //             there), column (1-based, not with at2 / accel),
 //             scale | pga_g (not both), duration_s
 //   [loop]    sensor_rate_hz, contact_rtol, max_substeps_per_step,
-//             contact_count_depth_m, energy_ledger, divergence_limit_m,
+//             contact_count_depth_m, energy_ledger (default false),
+//             floor_peaks (default true), divergence_limit_m,
 //             scalar = "double" | "float"
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
 //
@@ -380,6 +381,7 @@ void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
   s.read("max_substeps_per_step", &l->max_substeps_per_step);
   s.read("contact_count_depth_m", &l->contact_count_depth_m);
   s.read("energy_ledger", &l->energy_ledger);
+  s.read("floor_peaks", &l->floor_peaks);
   s.read("divergence_limit_m", &l->divergence_limit_m);
   s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}}, scalar);
 }
@@ -430,6 +432,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   scene.path = origin;
   scene.name = fs::path(origin).stem().string();
   SceneParams& p = scene.params;
+  p.loop.floor_peaks = true;  // a scene's run reports every floor unless told not to
 
   const Section meta(origin, root, "scene", {"name"});
   if (meta.read("name", &scene.name) && scene.name.empty())
@@ -462,7 +465,8 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   read_record(record, &scene);
   read_loop(Section(origin, root, "loop",
                     {"sensor_rate_hz", "contact_rtol", "max_substeps_per_step",
-                     "contact_count_depth_m", "energy_ledger", "divergence_limit_m", "scalar"}),
+                     "contact_count_depth_m", "energy_ledger", "floor_peaks", "divergence_limit_m",
+                     "scalar"}),
             &p.loop, &scene.scalar);
 
   // The shared range checks, reported at the offending key's line.

@@ -205,7 +205,9 @@ class Cache {
     if (!err.ok()) fail(s.path, std::string(err.field) + ": " + err.message);
     return e;
   }
-  static RunTotals run_totals(const Scene& s, const SceneParams& p, const Excitation& ex) {
+  // A study run: its figures need the top floor and E_e, not every floor.
+  static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex) {
+    p.loop.floor_peaks = false;
     std::unique_ptr<Engine> e = build(s, p);
     e->init(ex.samples[0]);
     for (std::size_t k = 1; k < ex.samples.size(); ++k) e->step(ex.samples[k]);

@@ -32,6 +32,8 @@ inline SceneParams paper_scene(DeviceKind kind, ContactLaw law = ContactLaw::kKu
   p.device.kind = kind;
   p.device.vines.law = law;
   p.loop.sensor_rate_hz = rate_hz;
+  p.loop.energy_ledger = true;  // the tests check the balance and every floor
+  p.loop.floor_peaks = true;
   return p;
 }
 

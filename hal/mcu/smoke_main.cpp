@@ -27,6 +27,7 @@ const char* run_smoke(double* f1_hz, long* contacts) {
   vines::SceneParams scene;
   vines::apply_frame_preset(vines::FramePreset::kTable1, &scene.frame);
   scene.device.kind = vines::DeviceKind::kVines;
+  scene.loop.energy_ledger = true;  // the smoke run checks the balance
 
   vines::SceneParams bad = scene;  // the checks must also refuse
   bad.device.vines.beta = 0.9;

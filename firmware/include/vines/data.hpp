@@ -65,15 +65,16 @@ struct Data {
   S contact_depth = S(0);   // deepest overlap of the current contact
   S max_overlap = S(0);     // deepest overlap of the run
 
-  // Outputs at the current time.
-  VecN x = VecN::Zero(), v = VecN::Zero();
-  // Running maxima over the whole run (continuous in time, not just samples).
+  // The top floor and the device floor now (kept: every step needs them).
+  S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
+  // Running maxima over the whole run (continuous in time, not just samples);
+  // per floor only with loop.floor_peaks.
   VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();
   S peak_top = S(0);
   double t_peak_top = 0;
   S peak_top_velocity = S(0);  // largest |v| of the top floor at the samples
   double elastic_energy = 0;  // E_e = integral of (1/2) x^T K x dt [J s]
-  double strain_increments = 0;  // sum of positive increments of the strain energy [J]
+  double strain_increments = 0;  // sum of positive increments of the strain energy [J] (floor_peaks)
   double last_strain = 0;
   Ledger ledger;
   Counters count;

@@ -1,9 +1,13 @@
 // The linear part of the model (frame, plus a TMD when there is one) as
-//   z' = A z + bg a_g(t) + bf F(t),
-// with A block-diagonal in blocks of size B (B = 2: one block per mode in
-// modal coordinates; B = NX: one dense block). Over a sensor step the ground
-// acceleration is linear between two samples and F = 0, so the step is exact:
-//   z_{k+1} = Phi z_k + Gam [a_k, a_{k+1}]^T   (first-order-hold discretisation).
+//   z' = A z + bg a_g(t) + bf F(t),   z = [positions; velocities] (P each),
+// in one of two forms:
+//   - modal (no device, VI NES): P independent oscillators, every matrix is
+//     diagonal per block, stored as structure-of-arrays vectors over the
+//     modes so that a step is a handful of vector operations;
+//   - dense (TMD): one full block.
+// Over a sensor step the ground acceleration is linear between two samples and
+// F = 0, so the step is exact (first-order-hold discretisation):
+//   z_{k+1} = Phi z_k + Gam [a_k, a_{k+1}]^T.
 // Quadratic integrals of the state over a step (strain energy, damping
 // dissipation, input work) are exact too (Van Loan 1978). Everything is
 // computed once in double, then stored in the loop's scalar S.
@@ -15,93 +19,123 @@
 
 namespace vines {
 
-// Continuous-time description, in double, handed to the builders below.
+// Continuous-time description, in double, handed to the builders below. In
+// the modal form A, bg, bf and every quadratic form must not couple modes:
+// only entries (j, j), (j, P+j), (P+j, j), (P+j, P+j) are read.
 template <int NX>
 struct LtiSpec {
-  Eigen::Matrix<double, NX, NX> a;  // must be block-diagonal in the chosen B
+  Eigen::Matrix<double, NX, NX> a;
   Eigen::Matrix<double, NX, 1> bg;  // ground acceleration input
   Eigen::Matrix<double, NX, 1> bf;  // device force input (on the device floor)
 };
 
-template <typename S, int NX, int B>
-struct Lti {
-  static_assert(NX % B == 0, "blocks must tile the state");
-  static constexpr int NB = NX / B;
-  using VecX = Eigen::Matrix<S, NX, 1>;
-  using Block = Eigen::Matrix<S, B, B>;
-  using Col = Eigen::Matrix<S, B, 1>;
+// ---------------------------------------------------------------- modal form
 
-  Block phi[NB];                     // exact step
-  Eigen::Matrix<S, B, 2> gam[NB];    // FOH input gains for (a_k, a_{k+1})
-  Block a[NB];                       // continuous time, for sub-stepping
-  Col bg[NB];
-  Col bf[NB];
+template <typename S, int P>
+struct ModalLti {
+  using VecX = Eigen::Matrix<S, 2 * P, 1>;
+  using VecP = Eigen::Matrix<S, P, 1>;
+  // Exact step: q1 = p11 q + p12 q' + gx0 a0 + gx1 a1, q1' likewise.
+  VecP p11, p12, p21, p22, gx0, gx1, gv0, gv1;
+  // Continuous time: q'' = ak q + ac q' + bgv a_g + bfv F.
+  VecP ak, ac, bgv, bfv;
 
-  // One exact sensor step with no device force.
   void step(VecX& z, S a0, S a1) const {
-    for (int b = 0; b < NB; ++b) {
-      const Col zb = z.template segment<B>(b * B);
-      z.template segment<B>(b * B) = phi[b] * zb + gam[b].col(0) * a0 + gam[b].col(1) * a1;
-    }
+    const auto q = z.template head<P>().array();
+    const auto v = z.template tail<P>().array();
+    const VecP q1 = p11.array() * q + p12.array() * v + gx0.array() * a0 + gx1.array() * a1;
+    z.template tail<P>() = p21.array() * q + p22.array() * v + gv0.array() * a0 + gv1.array() * a1;
+    z.template head<P>() = q1;
   }
 
-  // z' for sub-stepping: ground acceleration a, device force f.
+  // z' for sub-stepping: ground acceleration ag, device force f.
   VecX derivative(const VecX& z, S ag, S f) const {
     VecX d;
-    for (int b = 0; b < NB; ++b)
-      d.template segment<B>(b * B) =
-          a[b] * z.template segment<B>(b * B) + bg[b] * ag + bf[b] * f;
+    d.template head<P>() = z.template tail<P>();
+    d.template tail<P>() = ak.array() * z.template head<P>().array() +
+                           ac.array() * z.template tail<P>().array() + bgv.array() * ag + bfv.array() * f;
     return d;
   }
+
+  // Velocity jump of an impulse j of the device force.
+  void impulse(VecX& z, S j) const { z.template tail<P>() += bfv * j; }
 };
 
-// Exact quadratic integral over one step: integral_0^h xi(s)^T Q xi(s) ds with
-// xi = [z; a_g], as a quadratic form in (z_k, a_k, a_{k+1}), block by block.
-template <typename S, int NX, int B>
-struct QuadIntegral {
-  static constexpr int NB = NX / B;
-  Eigen::Matrix<S, B + 2, B + 2> w[NB];
+// Integral over one step of a quadratic form in [z; a_g], as a form in
+// (q, q', a0, a1): cross terms already doubled.
+template <typename S, int P>
+struct ModalQuad {
+  using VecX = Eigen::Matrix<S, 2 * P, 1>;
+  using VecP = Eigen::Matrix<S, P, 1>;
+  VecP qq, qv, vv, q0, q1, v0, v1;
+  S c00 = S(0), c01 = S(0), c11 = S(0);
 
-  S eval(const Eigen::Matrix<S, NX, 1>& z, S a0, S a1) const {
-    S sum = S(0);
-    for (int b = 0; b < NB; ++b) {
-      Eigen::Matrix<S, B + 2, 1> xi;
-      xi << z.template segment<B>(b * B), a0, a1;
-      sum += xi.dot(w[b] * xi);
-    }
-    return sum;
+  S eval(const VecX& z, S a0, S a1) const {
+    const auto q = z.template head<P>().array();
+    const auto v = z.template tail<P>().array();
+    return (q * (qq.array() * q + qv.array() * v + q0.array() * a0 + q1.array() * a1)).sum() +
+           (v * (vv.array() * v + v0.array() * a0 + v1.array() * a1)).sum() +
+           a0 * (c00 * a0 + c01 * a1) + c11 * a1 * a1;
   }
 };
 
-// Instantaneous quadratic form [z; a]^T Q [z; a] with the same block
-// structure: a per-block matrix and a per-block coupling with a.
-template <typename S, int NX, int B>
-struct BlockForm {
-  static constexpr int NB = NX / B;
-  Eigen::Matrix<S, B, B> zz[NB];
-  Eigen::Matrix<S, B, 1> za[NB];
+// Instantaneous quadratic form [z; a]^T Q [z; a] (cross terms doubled).
+template <typename S, int P>
+struct ModalForm {
+  using VecX = Eigen::Matrix<S, 2 * P, 1>;
+  using VecP = Eigen::Matrix<S, P, 1>;
+  VecP qq, qv, vv, qa, va;
   S aa = S(0);
 
-  S eval(const Eigen::Matrix<S, NX, 1>& z, S ag) const {
-    S sum = aa * ag * ag;
-    for (int b = 0; b < NB; ++b) {
-      const Eigen::Matrix<S, B, 1> zb = z.template segment<B>(b * B);
-      sum += zb.dot(zz[b] * zb) + S(2) * ag * za[b].dot(zb);
-    }
-    return sum;
+  S eval(const VecX& z, S ag) const {
+    const auto q = z.template head<P>().array();
+    const auto v = z.template tail<P>().array();
+    return (q * (qq.array() * q + qv.array() * v + qa.array() * ag)).sum() +
+           (v * (vv.array() * v + va.array() * ag)).sum() + aa * ag * ag;
   }
 };
 
-template <typename S, int NX, int B>
-BlockForm<S, NX, B> block_form(const Eigen::Matrix<double, NX + 1, NX + 1>& q) {
-  BlockForm<S, NX, B> out;
-  for (int b = 0; b < NX / B; ++b) {
-    out.zz[b] = q.template block<B, B>(b * B, b * B).template cast<S>();
-    out.za[b] = q.template block<B, 1>(b * B, NX).template cast<S>();
+// ---------------------------------------------------------------- dense form
+
+template <typename S, int NX>
+struct DenseLti {
+  using VecX = Eigen::Matrix<S, NX, 1>;
+  Eigen::Matrix<S, NX, NX> phi, a;
+  VecX g0, g1, bg, bf;
+
+  void step(VecX& z, S a0, S a1) const {
+    const VecX z0 = z;  // lazyProduct reads z while it is written: no aliasing
+    z = phi.lazyProduct(z0) + g0 * a0 + g1 * a1;
   }
-  out.aa = static_cast<S>(q(NX, NX));
-  return out;
-}
+  VecX derivative(const VecX& z, S ag, S f) const { return a.lazyProduct(z) + bg * ag + bf * f; }
+  void impulse(VecX& z, S j) const { z += bf * j; }
+};
+
+template <typename S, int NX>
+struct DenseQuad {
+  using VecX = Eigen::Matrix<S, NX, 1>;
+  Eigen::Matrix<S, NX + 2, NX + 2> w;
+
+  S eval(const VecX& z, S a0, S a1) const {
+    Eigen::Matrix<S, NX + 2, 1> xi;
+    xi << z, a0, a1;
+    return xi.dot(w.lazyProduct(xi));
+  }
+};
+
+template <typename S, int NX>
+struct DenseForm {
+  using VecX = Eigen::Matrix<S, NX, 1>;
+  Eigen::Matrix<S, NX + 1, NX + 1> q;
+
+  S eval(const VecX& z, S ag) const {
+    Eigen::Matrix<S, NX + 1, 1> xi;
+    xi << z, ag;
+    return xi.dot(q.lazyProduct(xi));
+  }
+};
+
+// ---------------------------------------------------------------- builders
 
 namespace detail {
 
@@ -116,65 +150,153 @@ Eigen::Matrix<double, B + 2, B + 2> augmented(const Eigen::Matrix<double, B, B>&
   return m;
 }
 
+// Exact FOH step of z' = ab z + bgb a_g over h: Phi and the gains of (a0, a1).
+template <int B>
+struct Foh {
+  Eigen::Matrix<double, B, B> phi;
+  Eigen::Matrix<double, B, 1> g0, g1;
+};
+template <int B>
+Foh<B> foh(const Eigen::Matrix<double, B, B>& ab, const Eigen::Matrix<double, B, 1>& bgb, double h) {
+  // exp(Abar h) = [[Phi, P, Q], [0, 1, h], [0, 0, 1]] and
+  // z(h) = Phi z0 + P a0 + Q (a1 - a0) / h.
+  const Eigen::Matrix<double, B + 2, B + 2> e =
+      numeric::expm(Eigen::Matrix<double, B + 2, B + 2>(augmented<B>(ab, bgb) * h));
+  const Eigen::Matrix<double, B, 1> p = e.template block<B, 1>(0, B);
+  const Eigen::Matrix<double, B, 1> q = e.template block<B, 1>(0, B + 1);
+  return {e.template topLeftCorner<B, B>(), p - q / h, q / h};
+}
+
+// Exact integral over h of xi^T qb xi, xi = [z; a; a'] (Van Loan:
+// exp([[-Abar^T, Qb], [0, Abar]] h) = [[., G], [0, F]], integral = F^T G), as a
+// symmetric form in [z; a0; a1].
+template <int B>
+Eigen::Matrix<double, B + 2, B + 2> van_loan(const Eigen::Matrix<double, B, B>& ab,
+                                             const Eigen::Matrix<double, B, 1>& bgb,
+                                             const Eigen::Matrix<double, B + 2, B + 2>& qb, double h) {
+  constexpr int D = B + 2;
+  const Eigen::Matrix<double, D, D> abar = augmented<B>(ab, bgb);
+  Eigen::Matrix<double, 2 * D, 2 * D> vl = Eigen::Matrix<double, 2 * D, 2 * D>::Zero();
+  vl.template topLeftCorner<D, D>() = -abar.transpose();
+  vl.template topRightCorner<D, D>() = qb;
+  vl.template bottomRightCorner<D, D>() = abar;
+  const Eigen::Matrix<double, 2 * D, 2 * D> e = numeric::expm(Eigen::Matrix<double, 2 * D, 2 * D>(vl * h));
+  const Eigen::Matrix<double, D, D> w =
+      e.template bottomRightCorner<D, D>().transpose() * e.template topRightCorner<D, D>();
+  // Change of variables [z; a0; a'] = T [z; a0; a1], a' = (a1 - a0) / h.
+  Eigen::Matrix<double, D, D> t = Eigen::Matrix<double, D, D>::Identity();
+  t(B + 1, B) = -1.0 / h;
+  t(B + 1, B + 1) = 1.0 / h;
+  const Eigen::Matrix<double, D, D> wt = t.transpose() * w * t;
+  return 0.5 * (wt + wt.transpose());
+}
+
+// Mode j's 2x2 part of an NX-square matrix in the [q; q'] layout.
+template <int P, typename Mat>
+Eigen::Matrix2d mode_block(const Mat& m, int j) {
+  Eigen::Matrix2d b;
+  b << m(j, j), m(j, P + j), m(P + j, j), m(P + j, P + j);
+  return b;
+}
+
 }  // namespace detail
 
-// Exact FOH discretisation of spec over a step h.
-template <typename S, int NX, int B>
-Lti<S, NX, B> discretise(const LtiSpec<NX>& spec, double h) {
-  Lti<S, NX, B> out;
-  for (int b = 0; b < NX / B; ++b) {
-    const Eigen::Matrix<double, B, B> ab = spec.a.template block<B, B>(b * B, b * B);
-    const Eigen::Matrix<double, B, 1> bgb = spec.bg.template segment<B>(b * B);
-    // exp(Abar h) = [[Phi, P, Q], [0, 1, h], [0, 0, 1]] and
-    // z(h) = Phi z0 + P a0 + Q (a1 - a0) / h.
-    const Eigen::Matrix<double, B + 2, B + 2> e = numeric::expm(
-        Eigen::Matrix<double, B + 2, B + 2>(detail::augmented<B>(ab, bgb) * h));
-    const Eigen::Matrix<double, B, 1> p = e.template block<B, 1>(0, B);
-    const Eigen::Matrix<double, B, 1> q = e.template block<B, 1>(0, B + 1);
-    out.phi[b] = e.template topLeftCorner<B, B>().template cast<S>();
-    out.gam[b].col(0) = (p - q / h).template cast<S>();
-    out.gam[b].col(1) = (q / h).template cast<S>();
-    out.a[b] = ab.template cast<S>();
-    out.bg[b] = bgb.template cast<S>();
-    out.bf[b] = spec.bf.template segment<B>(b * B).template cast<S>();
+template <typename S, int P>
+ModalLti<S, P> discretise_modal(const LtiSpec<2 * P>& spec, double h) {
+  ModalLti<S, P> out;
+  for (int j = 0; j < P; ++j) {
+    const Eigen::Matrix2d ab = detail::mode_block<P>(spec.a, j);
+    const Eigen::Vector2d bgb(spec.bg(j), spec.bg(P + j));
+    const detail::Foh<2> f = detail::foh<2>(ab, bgb, h);
+    out.p11(j) = static_cast<S>(f.phi(0, 0));
+    out.p12(j) = static_cast<S>(f.phi(0, 1));
+    out.p21(j) = static_cast<S>(f.phi(1, 0));
+    out.p22(j) = static_cast<S>(f.phi(1, 1));
+    out.gx0(j) = static_cast<S>(f.g0(0));
+    out.gx1(j) = static_cast<S>(f.g1(0));
+    out.gv0(j) = static_cast<S>(f.g0(1));
+    out.gv1(j) = static_cast<S>(f.g1(1));
+    out.ak(j) = static_cast<S>(ab(1, 0));
+    out.ac(j) = static_cast<S>(ab(1, 1));
+    out.bgv(j) = static_cast<S>(bgb(1));
+    out.bfv(j) = static_cast<S>(spec.bf(P + j));
   }
   return out;
 }
 
-// Exact integral over a step h of [z; a]^T Q [z; a]; Q (NX+1 square, symmetric)
-// must not couple different blocks of z (it may couple any block with a).
-template <typename S, int NX, int B>
-QuadIntegral<S, NX, B> quad_integral(const LtiSpec<NX>& spec,
-                                     const Eigen::Matrix<double, NX + 1, NX + 1>& q, double h) {
-  constexpr int D = B + 2;
-  QuadIntegral<S, NX, B> out;
-  for (int b = 0; b < NX / B; ++b) {
-    const Eigen::Matrix<double, B, B> ab = spec.a.template block<B, B>(b * B, b * B);
-    const Eigen::Matrix<double, B, 1> bgb = spec.bg.template segment<B>(b * B);
-    // Weight on [z_b; a; a']: this block's part of Q; the a-a term goes to block 0.
-    Eigen::Matrix<double, D, D> qb = Eigen::Matrix<double, D, D>::Zero();
-    qb.template topLeftCorner<B, B>() = q.template block<B, B>(b * B, b * B);
-    qb.template block<B, 1>(0, B) = q.template block<B, 1>(b * B, NX);
-    qb.template block<1, B>(B, 0) = q.template block<1, B>(NX, b * B);
-    if (b == 0) qb(B, B) = q(NX, NX);
-    // Van Loan: exp([[-Abar^T, Qb], [0, Abar]] h) = [[., G], [0, F]],
-    // integral_0^h exp(Abar^T s) Qb exp(Abar s) ds = F^T G.
-    const Eigen::Matrix<double, D, D> abar = detail::augmented<B>(ab, bgb);
-    Eigen::Matrix<double, 2 * D, 2 * D> vl = Eigen::Matrix<double, 2 * D, 2 * D>::Zero();
-    vl.template topLeftCorner<D, D>() = -abar.transpose();
-    vl.template topRightCorner<D, D>() = qb;
-    vl.template bottomRightCorner<D, D>() = abar;
-    const Eigen::Matrix<double, 2 * D, 2 * D> e =
-        numeric::expm(Eigen::Matrix<double, 2 * D, 2 * D>(vl * h));
-    const Eigen::Matrix<double, D, D> w =
-        e.template bottomRightCorner<D, D>().transpose() * e.template topRightCorner<D, D>();
-    // Change of variables [z; a0; a'] = T [z; a0; a1], a' = (a1 - a0) / h.
-    Eigen::Matrix<double, D, D> t = Eigen::Matrix<double, D, D>::Identity();
-    t(B + 1, B) = -1.0 / h;
-    t(B + 1, B + 1) = 1.0 / h;
-    const Eigen::Matrix<double, D, D> wt = t.transpose() * w * t;
-    out.w[b] = (0.5 * (wt + wt.transpose())).template cast<S>();
+template <typename S, int NX>
+DenseLti<S, NX> discretise_dense(const LtiSpec<NX>& spec, double h) {
+  const detail::Foh<NX> f = detail::foh<NX>(spec.a, spec.bg, h);
+  DenseLti<S, NX> out;
+  out.phi = f.phi.template cast<S>();
+  out.g0 = f.g0.template cast<S>();
+  out.g1 = f.g1.template cast<S>();
+  out.a = spec.a.template cast<S>();
+  out.bg = spec.bg.template cast<S>();
+  out.bf = spec.bf.template cast<S>();
+  return out;
+}
+
+// Exact integral over a step h of [z; a]^T Q [z; a] (Q: NX+1 square, symmetric).
+template <typename S, int P>
+ModalQuad<S, P> quad_integral_modal(const LtiSpec<2 * P>& spec,
+                                    const Eigen::Matrix<double, 2 * P + 1, 2 * P + 1>& q, double h) {
+  constexpr int NX = 2 * P;
+  ModalQuad<S, P> out;
+  Eigen::Matrix2d aa = Eigen::Matrix2d::Zero();  // the a-a part, summed over modes
+  for (int j = 0; j < P; ++j) {
+    // Weight on [q_j; q_j'; a; a']: this mode's part of Q; the a-a term once.
+    Eigen::Matrix4d qb = Eigen::Matrix4d::Zero();
+    qb.topLeftCorner<2, 2>() = detail::mode_block<P>(q, j);
+    qb(0, 2) = qb(2, 0) = q(j, NX);
+    qb(1, 2) = qb(2, 1) = q(P + j, NX);
+    if (j == 0) qb(2, 2) = q(NX, NX);
+    const Eigen::Matrix4d w = detail::van_loan<2>(detail::mode_block<P>(spec.a, j),
+                                                  Eigen::Vector2d(spec.bg(j), spec.bg(P + j)), qb, h);
+    out.qq(j) = static_cast<S>(w(0, 0));
+    out.qv(j) = static_cast<S>(2 * w(0, 1));
+    out.vv(j) = static_cast<S>(w(1, 1));
+    out.q0(j) = static_cast<S>(2 * w(0, 2));
+    out.q1(j) = static_cast<S>(2 * w(0, 3));
+    out.v0(j) = static_cast<S>(2 * w(1, 2));
+    out.v1(j) = static_cast<S>(2 * w(1, 3));
+    aa += w.bottomRightCorner<2, 2>();
   }
+  out.c00 = static_cast<S>(aa(0, 0));
+  out.c01 = static_cast<S>(2 * aa(0, 1));
+  out.c11 = static_cast<S>(aa(1, 1));
+  return out;
+}
+
+template <typename S, int NX>
+DenseQuad<S, NX> quad_integral_dense(const LtiSpec<NX>& spec, const Eigen::Matrix<double, NX + 1, NX + 1>& q,
+                                     double h) {
+  Eigen::Matrix<double, NX + 2, NX + 2> qb = Eigen::Matrix<double, NX + 2, NX + 2>::Zero();
+  qb.template topLeftCorner<NX + 1, NX + 1>() = q;
+  DenseQuad<S, NX> out;
+  out.w = detail::van_loan<NX>(spec.a, spec.bg, qb, h).template cast<S>();
+  return out;
+}
+
+template <typename S, int P>
+ModalForm<S, P> form_modal(const Eigen::Matrix<double, 2 * P + 1, 2 * P + 1>& q) {
+  constexpr int NX = 2 * P;
+  ModalForm<S, P> out;
+  for (int j = 0; j < P; ++j) {
+    out.qq(j) = static_cast<S>(q(j, j));
+    out.qv(j) = static_cast<S>(2 * q(j, P + j));
+    out.vv(j) = static_cast<S>(q(P + j, P + j));
+    out.qa(j) = static_cast<S>(2 * q(j, NX));
+    out.va(j) = static_cast<S>(2 * q(P + j, NX));
+  }
+  out.aa = static_cast<S>(q(NX, NX));
+  return out;
+}
+
+template <typename S, int NX>
+DenseForm<S, NX> form_dense(const Eigen::Matrix<double, NX + 1, NX + 1>& q) {
+  DenseForm<S, NX> out;
+  out.q = q.template cast<S>();
   return out;
 }
 

@@ -1,12 +1,13 @@
 // The immutable model: everything the loop needs, computed once from the
-// scene parameters (in double) and stored in the loop's scalar S. Layout of
-// the linear state z:
-//   no device, VI NES: modal coordinates [q1, q1', q2, q2', ...] (B = 2 blocks)
-//   TMD:               physical [x_1..x_N, x_d, v_1..v_N, v_d]     (one dense block)
+// scene parameters (in double) and stored in the loop's scalar S. The linear
+// state z is [positions; velocities]:
+//   no device, VI NES: modal coordinates [q_1..q_N, q_1'..q_N'] (modal form)
+//   TMD:               physical [x_1..x_N, x_d, v_1..v_N, v_d]     (dense form)
 #pragma once
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -20,11 +21,13 @@ namespace vines {
 
 template <typename Dev, int N>
 struct Layout {
-  static constexpr int kNx = 2 * N, kB = 2, kP = N;  // kP: position coordinates
+  static constexpr bool kModal = true;
+  static constexpr int kNx = 2 * N, kP = N;  // kP: position coordinates
 };
 template <int N>
 struct Layout<TmdDevice, N> {
-  static constexpr int kNx = 2 * (N + 1), kB = 2 * (N + 1), kP = N + 1;
+  static constexpr bool kModal = false;
+  static constexpr int kNx = 2 * (N + 1), kP = N + 1;
 };
 
 // Device constants in the loop's scalar.
@@ -59,11 +62,15 @@ struct DeviceModel<S, VinesDevice<L>> {
 
 template <typename S, int N, typename Dev>
 struct Model {
+  static constexpr bool kModal = Layout<Dev, N>::kModal;
   static constexpr int kNx = Layout<Dev, N>::kNx;
-  static constexpr int kB = Layout<Dev, N>::kB;
   static constexpr int kP = Layout<Dev, N>::kP;
   using VecX = Eigen::Matrix<S, kNx, 1>;
   using VecN = Eigen::Matrix<S, N, 1>;
+  using VecP = Eigen::Matrix<S, kP, 1>;
+  using LtiT = std::conditional_t<kModal, ModalLti<S, kP>, DenseLti<S, kNx>>;
+  using QuadT = std::conditional_t<kModal, ModalQuad<S, kP>, DenseQuad<S, kNx>>;
+  using FormT = std::conditional_t<kModal, ModalForm<S, kP>, DenseForm<S, kNx>>;
 
   // Reporting (double): the frame as simulated, its modes, the nominal modes.
   Frame<N> frame;
@@ -75,38 +82,42 @@ struct Model {
   S hs = S(0);           // h in S
 
   // Exact step and exact step integrals of the linear part.
-  Lti<S, kNx, kB> lti;
-  QuadIntegral<S, kNx, kB> strain_step;   // integral of (1/2) x^T K x: E_e
-  QuadIntegral<S, kNx, kB> input_step;    // input work of the linear part's masses
-  QuadIntegral<S, kNx, kB> damping_step;  // dashpot dissipation
+  LtiT lti;
+  QuadT strain_step;   // integral of (1/2) x^T K x: E_e
+  QuadT input_step;    // input work of the linear part's masses
+  QuadT damping_step;  // dashpot dissipation
   // Instantaneous forms: energies and powers.
-  BlockForm<S, kNx, kB> kinetic, strain, device_potential, damping_power, input_power;
+  FormT kinetic, strain, device_potential, damping_power, input_power;
 
-  // Floors from z: x = pos_map * (position coordinates), likewise v.
+  // Floors from z: x = pos_map * (position coordinates), likewise v; the
+  // rows of the top floor and the device floor, contiguous.
   Eigen::Matrix<S, N, kP> pos_map;
+  VecP top_row, floor_row, bound_row;
   // Absolute floor acceleration: -(M^-1 K) x - (M^-1 C) v + (force on floor f) / m_f.
   Eigen::Matrix<S, N, N> minv_k, minv_c;
   S inv_floor_mass = S(0);
 
   DeviceModel<S, Dev> dev;
 
-  // Position and velocity coordinates of z.
-  Eigen::Matrix<S, kP, 1> positions(const VecX& z) const {
-    if constexpr (kB == 2)
-      return Eigen::Map<const Eigen::Matrix<S, kP, 1>, 0, Eigen::InnerStride<2>>(z.data());
-    else
-      return z.template head<kP>();
+  // z may be any expression of kNx values (a segment of a longer state).
+  template <typename Z>
+  VecN floor_x(const Eigen::MatrixBase<Z>& z) const { return pos_map.lazyProduct(z.template head<kP>()); }
+  template <typename Z>
+  VecN floor_v(const Eigen::MatrixBase<Z>& z) const { return pos_map.lazyProduct(z.template tail<kP>()); }
+  // Top floor and device floor (the hot path).
+  template <typename Z>
+  S top_x(const Eigen::MatrixBase<Z>& z) const { return top_row.dot(z.template head<kP>()); }
+  template <typename Z>
+  S top_v(const Eigen::MatrixBase<Z>& z) const { return top_row.dot(z.template tail<kP>()); }
+  template <typename Z>
+  S dev_x(const Eigen::MatrixBase<Z>& z) const { return floor_row.dot(z.template head<kP>()); }
+  template <typename Z>
+  S dev_v(const Eigen::MatrixBase<Z>& z) const { return floor_row.dot(z.template tail<kP>()); }
+  // A cheap bound on the largest |floor displacement|: sum of |q_j| max_i |phi_ij|.
+  template <typename Z>
+  S floor_bound(const Eigen::MatrixBase<Z>& z) const {
+    return bound_row.dot(z.template head<kP>().cwiseAbs());
   }
-  Eigen::Matrix<S, kP, 1> velocities(const VecX& z) const {
-    if constexpr (kB == 2)
-      return Eigen::Map<const Eigen::Matrix<S, kP, 1>, 0, Eigen::InnerStride<2>>(z.data() + 1);
-    else
-      return z.template tail<kP>();
-  }
-  VecN floor_x(const VecX& z) const { return pos_map * positions(z); }
-  VecN floor_v(const VecX& z) const { return pos_map * velocities(z); }
-  S floor_x(const VecX& z, int i) const { return pos_map.row(i).dot(positions(z)); }
-  S floor_v(const VecX& z, int i) const { return pos_map.row(i).dot(velocities(z)); }
 };
 
 namespace detail {
@@ -132,7 +143,7 @@ Eigen::Matrix<double, NX + 1, NX + 1> zz_form(const Eigen::Matrix<double, NX, NX
 template <typename S, int N, typename Dev>
 ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   using M = Model<S, N, Dev>;
-  constexpr int NX = M::kNx, B = M::kB, P = M::kP;
+  constexpr int NX = M::kNx, P = M::kP;
   Model<S, N, Dev>& md = *out;
 
   ParamError err = validate(p);
@@ -160,7 +171,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   const double floor_mass = md.frame.m(md.floor);
 
   // Classical damping is what makes the modal blocks exact: check it.
-  if constexpr (B == 2) {
+  if constexpr (M::kModal) {
     const Eigen::Matrix<double, N, N> cm = md.modal.phi.transpose() * md.frame.C * md.modal.phi;
     const double diag = cm.diagonal().cwiseAbs().maxCoeff();
     if ((cm - Eigen::Matrix<double, N, N>(cm.diagonal().asDiagonal())).cwiseAbs().maxCoeff() >
@@ -211,17 +222,21 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     const Modal<N>& mo = md.modal;
     for (int j = 0; j < N; ++j) {
       const double w = mo.omega(j);
-      spec.a(2 * j, 2 * j + 1) = 1.0;
-      spec.a(2 * j + 1, 2 * j) = -w * w;
-      spec.a(2 * j + 1, 2 * j + 1) = -2.0 * mo.zeta(j) * w;
-      spec.bg(2 * j + 1) = -mo.gamma(j);
-      spec.bf(2 * j + 1) = mo.phi(md.floor, j);
-      px.col(2 * j) = mo.phi.col(j);
-      pv.col(2 * j + 1) = mo.phi.col(j);
+      spec.a(j, N + j) = 1.0;
+      spec.a(N + j, j) = -w * w;
+      spec.a(N + j, N + j) = -2.0 * mo.zeta(j) * w;
+      spec.bg(N + j) = -mo.gamma(j);
+      spec.bf(N + j) = mo.phi(md.floor, j);
+      px.col(j) = mo.phi.col(j);
+      pv.col(N + j) = mo.phi.col(j);
     }
     md.pos_map = mo.phi.template cast<S>();
   }
-  md.lti = discretise<S, NX, B>(spec, md.h);
+  md.top_row = md.pos_map.row(N - 1).transpose();
+  md.floor_row = md.pos_map.row(md.floor).transpose();
+  md.bound_row = md.pos_map.cwiseAbs().colwise().maxCoeff().transpose();
+  if constexpr (M::kModal) md.lti = discretise_modal<S, P>(spec, md.h);
+  else md.lti = discretise_dense<S, NX>(spec, md.h);
 
   // Energies and powers as quadratic forms in [z; a_g].
   using QX = Eigen::Matrix<double, NX, NX>;
@@ -235,15 +250,23 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   q_in.template block<NX, 1>(0, NX) = -0.5 * mv;
   q_in.template block<1, NX>(NX, 0) = -0.5 * mv.transpose();
 
-  md.kinetic = block_form<S, NX, B>(q_kin);
-  md.strain = block_form<S, NX, B>(q_strain);
-  md.device_potential = block_form<S, NX, B>(q_devpot);
-  md.damping_power = block_form<S, NX, B>(q_damp);
-  md.input_power = block_form<S, NX, B>(q_in);
-  md.strain_step = quad_integral<S, NX, B>(spec, q_strain, md.h);
+  auto form = [](const auto& q) {
+    if constexpr (M::kModal) return form_modal<S, P>(q);
+    else return form_dense<S, NX>(q);
+  };
+  auto integral = [&](const auto& q) {
+    if constexpr (M::kModal) return quad_integral_modal<S, P>(spec, q, md.h);
+    else return quad_integral_dense<S, NX>(spec, q, md.h);
+  };
+  md.kinetic = form(q_kin);
+  md.strain = form(q_strain);
+  md.device_potential = form(q_devpot);
+  md.damping_power = form(q_damp);
+  md.input_power = form(q_in);
+  md.strain_step = integral(q_strain);
   if (p.loop.energy_ledger) {
-    md.input_step = quad_integral<S, NX, B>(spec, q_in, md.h);
-    md.damping_step = quad_integral<S, NX, B>(spec, q_damp, md.h);
+    md.input_step = integral(q_in);
+    md.damping_step = integral(q_damp);
   }
 
   const Eigen::Matrix<double, N, 1> minv_frame = md.frame.m.cwiseInverse();

@@ -93,7 +93,11 @@ struct LoopParams {
   int max_substeps_per_step = 4096;
   // Contacts shallower than this are not counted (rounding at rest contact).
   double contact_count_depth_m = 1e-9;
-  bool energy_ledger = true;
+  // Outputs nobody asked for are not computed: the energy ledger (balance of
+  // input, dissipation and storage), and per-floor peaks and drifts with the
+  // strain-energy increments (the top-floor peak and E_e are always kept).
+  bool energy_ledger = false;
+  bool floor_peaks = false;
   // Divergence guard: a floor (or the TMD) farther than this from the ground
   // [m], or any non-finite state, rolls the step back (see sim.hpp).
   double divergence_limit_m = 100.0;

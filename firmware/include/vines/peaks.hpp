@@ -36,21 +36,33 @@ void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>
   }
 }
 
-// Peak of the top floor over an exact step: quintic Hermite with the
-// accelerations at both ends (error ~h^6), for a converged peak at any rate.
+// Peak of the top floor over an exact step from (x0, v0) at z0 to (x1, v1) at
+// z1: quintic Hermite with the accelerations at both ends (error ~h^6), for a
+// converged peak at any rate. Only steps that can beat the peak are refined.
 template <typename S, int N, typename Dev>
-void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
-                     const typename Model<S, N, Dev>::VecX& z0, S a0, S x0, S v0, S a1) {
-  const S x1 = d.x(N - 1), v1 = d.v(N - 1);
-  const S bound = std::fmax(std::fabs(x0), std::fabs(x1)) +
-                  S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
+void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z0,
+                     const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1) {
+  const S bound = std::fmax(std::fabs(x0), std::fabs(x1)) + S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
   if (bound <= d.peak_top) return;
-  const S acc0 = m.floor_v(m.lti.derivative(z0, a0, S(0)), N - 1);
-  const S acc1 = m.floor_v(m.lti.derivative(d.z, a1, S(0)), N - 1);
+  const S acc0 = m.top_v(m.lti.derivative(z0, a0, S(0)));
+  const S acc1 = m.top_v(m.lti.derivative(z1, a1, S(0)));
   const S p = numeric::quintic_abs_max(x0, v0, acc0, x1, v1, acc1, m.hs);
   if (p > d.peak_top) {
     d.peak_top = p;
     d.t_peak_top = d.time(m) + m.h;
+  }
+}
+
+// Peak of the top floor over a sub-step of length h (cubic Hermite).
+template <typename S, int N, typename Dev>
+void update_top_peak_cubic(Data<S, N, Dev>& d, S x0, S v0, S x1, S v1, S h, double t1) {
+  const S bound = std::fmax(std::fabs(x0), std::fabs(x1)) + S(0.5) * h * (std::fabs(v0) + std::fabs(v1));
+  if (bound <= d.peak_top) return;
+  const S p = std::fmax(numeric::Cubic<S>::make(x0, v0, x1, v1, h).max_value(),
+                        numeric::Cubic<S>::make(-x0, -v0, -x1, -v1, h).max_value());
+  if (p > d.peak_top) {
+    d.peak_top = p;
+    d.t_peak_top = t1;
   }
 }
 

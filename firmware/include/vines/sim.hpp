@@ -1,10 +1,13 @@
 // The fixed-step loop: one step per sensor sample, the ground acceleration
 // linear between two samples. Pipeline of a step:
-//   1. linear part + free particle: exact discretisation (no sub-steps);
-//   2. if the particle touches a wall, or may during the step: adaptive
-//      Dormand-Prince sub-steps through the step, contact starts and ends
-//      located to rounding, capped per step (cap hits are counted);
-//   3. outputs, running maxima (continuous in time), E_e, energy ledger.
+//   1. exact step of the linear part and the free particle into temporaries;
+//      a VI NES checks whether its particle may touch a wall during the step;
+//   2. if not: the exact step is committed with its exact step integrals
+//      (E_e; the energy ledger and per-floor peaks only when asked for);
+//      if so: adaptive Dormand-Prince sub-steps through the step, contact
+//      starts and ends located to rounding, capped per step (cap hits are
+//      counted);
+//   3. guards (non-finite input held, diverging steps rolled back), counters.
 // Work per step is bounded; no heap, no exceptions.
 #pragma once
 
@@ -37,6 +40,15 @@ void close_ledger(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   l.max_input = std::fmax(l.max_input, std::fmax(l.input, stored + dissipated));
 }
 
+// The top floor and the device floor from the state.
+template <typename S, int N, typename Dev>
+void refresh_floors(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
+  d.xt = m.top_x(d.z);
+  d.vt = m.top_v(d.z);
+  d.xf = m.dev_x(d.z);
+  d.vf = m.dev_v(d.z);
+}
+
 }  // namespace detail
 
 // Puts the run at t = 0 with ground acceleration a0: initial conditions of
@@ -54,11 +66,11 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
     d.s = S(0);
     d.sd = m.dev.v0;
   }
-  d.x = m.floor_x(d.z);
-  d.v = m.floor_v(d.z);
-  d.peak_x = d.x.cwiseAbs();
+  detail::refresh_floors(m, d);
+  d.peak_x = m.floor_x(d.z).cwiseAbs();
   d.peak_drift.setZero();
-  d.peak_top = std::fabs(d.x(N - 1));
+  d.peak_top = std::fabs(d.xt);
+  d.peak_top_velocity = std::fabs(d.vt);
   d.substep = m.hs;
   if (m.loop.energy_ledger) detail::close_ledger(m, d);
   d.last_strain = static_cast<double>(m.strain.eval(d.z, S(0)));
@@ -66,22 +78,72 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
 
 namespace detail {
 
-// Divergence check (MuJoCo-style warning): any non-finite state, a floor or
-// the TMD beyond the model's limit, or a particle beyond a wall by more than
-// its radius.
+// Divergence check (MuJoCo-style warning) on a state z (with the particle at
+// s, s'): anything non-finite, a floor or the TMD beyond the model's limit,
+// or a particle beyond a wall by more than its radius. The floors are first
+// bounded cheaply (sum of |q_j| max_i |phi_ij|); only a bound beyond the
+// limit costs the floors themselves.
 template <typename S, int N, typename Dev>
-bool diverged(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
-  if (!d.z.allFinite() || !(d.x.cwiseAbs().maxCoeff() <= limit)) return true;
+  const S bound = m.floor_bound(z);
+  if (!std::isfinite(bound) || !std::isfinite(z.template tail<Model<S, N, Dev>::kP>().sum())) return true;
+  if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
-    if (!(std::fabs(d.z(N)) <= limit)) return true;
+    if (!(std::fabs(z(N)) <= limit)) return true;
   }
   if constexpr (Dev::kKind == DeviceKind::kVines) {
-    const S r = d.s - d.x(m.floor), radius = static_cast<S>(m.dev.design.radius);
-    if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(d.sd))
-      return true;
+    const S r = s - xf, radius = static_cast<S>(m.dev.design.radius);
+    if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(sd)) return true;
   }
   return false;
+}
+
+// Commits an exact step to z1 (particle at s1, s1'), with its step integrals.
+template <typename S, int N, typename Dev>
+void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S a0,
+                  S a1, S s1, S sd1) {
+  const S xt1 = m.top_x(z1), vt1 = m.top_v(z1);
+  d.elastic_energy += static_cast<double>(m.strain_step.eval(d.z, a0, a1));
+  if (m.loop.energy_ledger) {
+    d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
+    d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
+    if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, d.sd, a0, a1);
+  }
+  if (m.loop.floor_peaks)
+    update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.hs, d.peak_x, d.peak_drift);
+  update_top_peak(m, d, d.z, z1, a0, a1, d.xt, d.vt, xt1, vt1);
+  d.z = z1;
+  d.xt = xt1;
+  d.vt = vt1;
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    d.s = s1;
+    d.sd = sd1;
+    d.xf = m.dev_x(z1);
+    d.vf = m.dev_v(z1);
+  }
+}
+
+// The particle may touch a wall within the step: it is in contact, or its
+// relative position may reach a wall (cubic through both ends of the free
+// step, with a margin for what a cubic misses).
+template <typename S, int N, typename Dev>
+bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S s1,
+               S sd1) {
+  const auto& dm = m.dev;
+  const S h = m.hs;
+  const S r0 = d.s - d.xf, rd0 = d.sd - d.vf;
+  const S r1 = s1 - m.dev_x(z1), rd1 = sd1 - m.dev_v(z1);
+  // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
+  // bounded by its end values plus what the cubic allows between them.
+  const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
+  const S reach = h * (std::fmax(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + tiny;
+  const S lo = std::fmin(r0, r1) - reach, hi = std::fmax(r0, r1) + reach;
+  if (lo > dm.wall_left && hi < dm.wall_right) return false;
+  const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + tiny;
+  const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
+  const auto right = numeric::Cubic<S>::make(r0 - dm.wall_right, rd0, r1 - dm.wall_right, rd1, h);
+  return left.max_value() + margin > S(0) || right.max_value() + margin > S(0);
 }
 
 }  // namespace detail
@@ -99,58 +161,70 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
     a1 = d.a_prev;
   }
   const S a0 = d.a_prev;
-  const Data<S, N, Dev> before = d;
-  const VecX z0 = d.z;
-  const typename Model<S, N, Dev>::VecN x0 = d.x, v0 = d.v;
 
-  bool exact = true;
-  if constexpr (Dev::kKind == DeviceKind::kVines) exact = !needs_substeps(m, d, a0, a1);
-
-  if (exact) {
-    // 1. Exact step: linear part, free particle, and their step integrals.
-    d.elastic_energy += static_cast<double>(m.strain_step.eval(z0, a0, a1));
-    if (m.loop.energy_ledger) {
-      d.ledger.input += static_cast<double>(m.input_step.eval(z0, a0, a1));
-      d.ledger.damping += static_cast<double>(m.damping_step.eval(z0, a0, a1));
+  // 1. Exact step into temporaries.
+  bool careful = false;
+  VecX z1 = d.z;
+  S s1 = S(0), sd1 = S(0);
+  if constexpr (Dev::kKind == DeviceKind::kVines) careful = d.mode != Mode::kFree;
+  if (!careful) {
+    m.lti.step(z1, a0, a1);
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      free_flight(m, d.s, d.sd, a0, a1, &s1, &sd1);
+      careful = detail::may_touch(m, d, z1, s1, sd1);
     }
-    m.lti.step(d.z, a0, a1);
-    if constexpr (Dev::kKind == DeviceKind::kVines) free_flight(m, d, a0, a1);
-    d.x = m.floor_x(d.z);
-    d.v = m.floor_v(d.z);
-    detail::update_top_peak(m, d, z0, a0, x0(N - 1), v0(N - 1), a1);
-    detail::update_peaks<S, N>(x0, v0, d.x, d.v, m.hs, d.peak_x, d.peak_drift);
-  } else {
-    // 2. Sub-stepped step through (possible) contacts.
-    if constexpr (Dev::kKind == DeviceKind::kVines) substep_through(m, d, a0, a1);
   }
 
-  if (detail::diverged(m, d)) {
-    const Counters count = d.count;
-    d = before;
-    d.count = count;
-    ++d.count.divergences;
+  if (!careful) {
+    // 2a. Commit the exact step, unless it diverged.
+    if (detail::diverged(m, z1, m.dev_x(z1), s1, sd1)) ++d.count.divergences;
+    else detail::commit_exact(m, d, z1, a0, a1, s1, sd1);
+  } else if constexpr (Dev::kKind == DeviceKind::kVines) {
+    // 2b. Sub-stepped step through (possible) contacts; rolled back whole if
+    // it diverged (rare steps: the copy is affordable here).
+    const Data<S, N, Dev> before = d;
+    substep_through(m, d, a0, a1);
+    detail::refresh_floors(m, d);
+    if (detail::diverged(m, d.z, d.xf, d.s, d.sd)) {
+      const Counters count = d.count;
+      d = before;
+      d.count = count;
+      ++d.count.divergences;
+    }
   }
 
   // 3. Bookkeeping.
-  if (std::fabs(d.v(N - 1)) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(d.v(N - 1));
+  if (std::fabs(d.vt) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(d.vt);
   ++d.k;
   ++d.count.steps;
   d.a_prev = a1;
-  const double strain_now = static_cast<double>(m.strain.eval(d.z, S(0)));
-  if (strain_now > d.last_strain) d.strain_increments += strain_now - d.last_strain;
-  d.last_strain = strain_now;
+  if (m.loop.floor_peaks) {
+    const double strain_now = static_cast<double>(m.strain.eval(d.z, S(0)));
+    if (strain_now > d.last_strain) d.strain_increments += strain_now - d.last_strain;
+    d.last_strain = strain_now;
+  }
   if (m.loop.energy_ledger) detail::close_ledger(m, d);
+}
+
+// Floor displacements and velocities now (outputs only).
+template <typename S, int N, typename Dev>
+Eigen::Matrix<S, N, 1> floor_displacements(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+  return m.floor_x(d.z);
+}
+template <typename S, int N, typename Dev>
+Eigen::Matrix<S, N, 1> floor_velocities(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+  return m.floor_v(d.z);
 }
 
 // Absolute floor accelerations [m/s^2] at the current time (outputs only).
 template <typename S, int N, typename Dev>
 Eigen::Matrix<S, N, 1> absolute_accel(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
-  Eigen::Matrix<S, N, 1> acc = -(m.minv_k * d.x) - m.minv_c * d.v;
+  const Eigen::Matrix<S, N, 1> x = m.floor_x(d.z), v = m.floor_v(d.z);
+  Eigen::Matrix<S, N, 1> acc = -(m.minv_k * x) - m.minv_c * v;
   S f_floor = S(0);
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     const auto& t = m.dev.design;
-    f_floor = static_cast<S>(t.k) * (d.z(N) - d.x(m.floor)) +
-              static_cast<S>(t.c) * (d.z(2 * N + 1) - d.v(m.floor));
+    f_floor = static_cast<S>(t.k) * (d.z(N) - x(m.floor)) + static_cast<S>(t.c) * (d.z(2 * N + 1) - v(m.floor));
   }
   if constexpr (Dev::kKind == DeviceKind::kVines) f_floor = -d.contact_force;
   acc(m.floor) += f_floor * m.inv_floor_mass;

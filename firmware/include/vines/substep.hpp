@@ -1,7 +1,6 @@
 // VI NES stage of the loop: the particle between the walls.
-//   - free_flight: exact step of the particle under -a_g alone;
-//   - needs_substeps: whether the particle touches, or may touch, a wall
-//     within the coming step (then the exact step is not used);
+//   - free_flight: exact step of the particle under -a_g alone (and the work
+//     of its inertial load);
 //   - substep_through: adaptive Dormand-Prince sub-steps over the step with
 //     the frame in modal coordinates, contact starts and ends located to
 //     rounding (the contact force is not smooth there), impacts of the
@@ -46,45 +45,29 @@ S overlap_right(const DM& dm, S r) { return r - dm.wall_right; }
 template <typename S, int N, typename Dev>
 S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
   if (d.mode != Mode::kContactLeft && d.mode != Mode::kContactRight) return S(0);
-  const S r = d.s - m.floor_x(d.z, m.floor);
+  const S r = d.s - m.dev_x(d.z);
   const S dl = d.mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
   return dl > S(0) ? S(0.4) * m.dev.c * dl * dl * std::sqrt(dl) : S(0);
 }
 
-// Exact free flight of the particle over one step (acceleration -a_g, linear),
-// with the work of its inertial load.
+// Exact free flight of the particle over one step (acceleration -a_g, linear
+// from a0 to a1): from (s, s') to (*s1, *sd1).
 template <typename S, int N, typename Dev>
-void free_flight(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
-  const S h = m.hs, al = (a1 - a0) / h, v0 = d.sd;
-  if (m.loop.energy_ledger) {
-    // -m integral of a(t) v(t) dt, a = a0 + al t, v = v0 - a0 t - al t^2 / 2.
-    const S h2 = h * h, h3 = h2 * h, h4 = h3 * h;
-    const S w = a0 * v0 * h - a0 * a0 * h2 / S(2) - a0 * al * h3 / S(6) + al * v0 * h2 / S(2) -
-                al * a0 * h3 / S(3) - al * al * h4 / S(8);
-    d.ledger.input -= static_cast<double>(m.dev.m * w);
-  }
-  d.s += v0 * h - a0 * h * h / S(2) - al * h * h * h / S(6);
-  d.sd = v0 - a0 * h - al * h * h / S(2);
+void free_flight(const Model<S, N, Dev>& m, S s, S sd, S a0, S a1, S* s1, S* sd1) {
+  const S h = m.hs, al = (a1 - a0) / h;
+  *s1 = s + sd * h - a0 * h * h / S(2) - al * h * h * h / S(6);
+  *sd1 = sd - a0 * h - al * h * h / S(2);
 }
 
-// True when the coming step cannot be taken exactly: the particle is in
-// contact, or its relative position may reach a wall within the step (cubic
-// through both ends of the free step, with a margin for what a cubic misses).
+// Work of the particle's inertial load over that step: -m integral a v dt,
+// a = a0 + al t, v = v0 - a0 t - al t^2 / 2.
 template <typename S, int N, typename Dev>
-bool needs_substeps(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S a0, S a1) {
-  if (d.mode != Mode::kFree) return true;
-  typename Model<S, N, Dev>::VecX z1 = d.z;
-  m.lti.step(z1, a0, a1);
+double free_flight_work(const Model<S, N, Dev>& m, S v0, S a0, S a1) {
   const S h = m.hs, al = (a1 - a0) / h;
-  const S s1 = d.s + d.sd * h - a0 * h * h / S(2) - al * h * h * h / S(6);
-  const S sd1 = d.sd - a0 * h - al * h * h / S(2);
-  const int f = m.floor;
-  const S r0 = d.s - m.floor_x(d.z, f), rd0 = d.sd - m.floor_v(d.z, f);
-  const S r1 = s1 - m.floor_x(z1, f), rd1 = sd1 - m.floor_v(z1, f);
-  const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + S(1e-9) * (m.dev.wall_right - m.dev.wall_left);
-  const auto left = numeric::Cubic<S>::make(m.dev.wall_left - r0, -rd0, m.dev.wall_left - r1, -rd1, h);
-  const auto right = numeric::Cubic<S>::make(r0 - m.dev.wall_right, rd0, r1 - m.dev.wall_right, rd1, h);
-  return left.max_value() + margin > S(0) || right.max_value() + margin > S(0);
+  const S h2 = h * h, h3 = h2 * h, h4 = h3 * h;
+  const S w = a0 * v0 * h - a0 * a0 * h2 / S(2) - a0 * al * h3 / S(6) + al * v0 * h2 / S(2) -
+              al * a0 * h3 / S(3) - al * al * h4 / S(8);
+  return static_cast<double>(m.dev.m * w);
 }
 
 namespace detail {
@@ -103,8 +86,8 @@ struct SubStepper {
   Mode mode;
 
   S ag(S t) const { return a0 + al * t; }
-  S rel_pos(const Vec& y) const { return y(NX) - m.floor_x(VecX(y.template head<NX>()), m.floor); }
-  S rel_vel(const Vec& y) const { return y(NX + 1) - m.floor_v(VecX(y.template head<NX>()), m.floor); }
+  S rel_pos(const Vec& y) const { return y(NX) - m.dev_x(y.template head<NX>()); }
+  S rel_vel(const Vec& y) const { return y(NX + 1) - m.dev_v(y.template head<NX>()); }
 
   // Force on the particle (positive to the right) and the power lost in it.
   void force(const Vec& y, S t, S* fp, S* loss) const {
@@ -126,7 +109,7 @@ struct SubStepper {
       // Riding the wall: the force that gives the particle the floor's
       // acceleration, m* (floor acceleration without the device + a_g).
       const VecX z = y.template head<NX>();
-      const S floor_acc = m.floor_v(m.lti.derivative(z, ag(t), S(0)), m.floor);
+      const S floor_acc = m.dev_v(m.lti.derivative(z, ag(t), S(0)));
       *fp = dm.m_star * (floor_acc + ag(t));
     }
   }
@@ -141,8 +124,12 @@ struct SubStepper {
     dy(NX) = y(NX + 1);
     dy(NX + 1) = -a + fp * m.dev.inv_m;
     dy(NX + 2) = loss;
-    dy(NX + 3) = m.input_power.eval(z, a) - a * m.dev.m * y(NX + 1);
-    dy(NX + 4) = m.damping_power.eval(z, a);
+    if (m.loop.energy_ledger) {
+      dy(NX + 3) = m.input_power.eval(z, a) - a * m.dev.m * y(NX + 1);
+      dy(NX + 4) = m.damping_power.eval(z, a);
+    } else {
+      dy(NX + 3) = dy(NX + 4) = S(0);
+    }
     dy(NX + 5) = m.strain.eval(z, a);
     return dy;
   }
@@ -152,7 +139,7 @@ struct SubStepper {
     const auto& dm = m.dev;
     S worst = S(0);
     for (int i = 0; i < NX + 2; ++i) {
-      const bool modal = i < NX, vel = modal ? (i % 2 == 1) : i == NX + 1;
+      const bool modal = i < NX, vel = modal ? i >= NX / 2 : i == NX + 1;
       S scale = vel ? dm.vel_scale : dm.pos_scale;
       if (modal) scale *= dm.modal_scale;
       const S mag = std::fmax(std::fabs(y0(i)), std::fabs(y1(i)));
@@ -165,22 +152,20 @@ struct SubStepper {
 
 }  // namespace detail
 
-// Bookkeeping of an accepted sub-step from y0 to y1: peaks, contact depth.
+// Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending at t1
+// within the run): peaks, contact depth.
 template <typename S, int N, typename Dev, typename Vec>
-void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0,
-                   const Vec& y1, S h) {
+void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0, const Vec& y1, S h,
+                   double t1) {
   constexpr int NX = Model<S, N, Dev>::kNx;
-  using VecX = typename Model<S, N, Dev>::VecX;
-  const VecX z0 = y0.template head<NX>(), z1 = y1.template head<NX>();
-  const typename Model<S, N, Dev>::VecN x0 = m.floor_x(z0), v0 = m.floor_v(z0);
-  const typename Model<S, N, Dev>::VecN x1 = m.floor_x(z1), v1 = m.floor_v(z1);
-  detail::update_peaks<S, N>(x0, v0, x1, v1, h, d.peak_x, d.peak_drift);
-  if (d.peak_x(N - 1) > d.peak_top) {
-    d.peak_top = d.peak_x(N - 1);
-    d.t_peak_top = d.time(m) + static_cast<double>(h);
-  }
+  const auto z0 = y0.template head<NX>();
+  const auto z1 = y1.template head<NX>();
+  detail::update_top_peak_cubic(d, m.top_x(z0), m.top_v(z0), m.top_x(z1), m.top_v(z1), h, t1);
+  if (m.loop.floor_peaks)
+    detail::update_peaks<S, N>(m.floor_x(z0), m.floor_v(z0), m.floor_x(z1), m.floor_v(z1), h, d.peak_x,
+                               d.peak_drift);
   if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
-    const S r = y1(NX) - m.floor_x(z1, m.floor);
+    const S r = y1(NX) - m.dev_x(z1);
     const S dl = mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
     if (dl > d.contact_depth) d.contact_depth = dl;
     if (dl > d.max_overlap) d.max_overlap = dl;
@@ -191,6 +176,7 @@ void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, con
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
   constexpr int NX = Model<S, N, Dev>::kNx;
+  using VecX = typename Model<S, N, Dev>::VecX;
   const auto& dm = m.dev;
 #ifdef VINES_TRACE
   std::printf("event t=%.6f mode=%d side=%d r=%.6e rd=%.6e depth=%.3e\n", d.time(m), (int)st.mode, side,
@@ -208,8 +194,9 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
         const S j = contact::restitution_impulse(dm.m, S(1) / m.inv_floor_mass, v_app, e);
         const S jp = side < 0 ? j : -j;  // impulse on the particle
         y(NX + 1) += jp * dm.inv_m;
-        for (int b = 0; b < Model<S, N, Dev>::kNx / 2; ++b)
-          y.template segment<2>(2 * b) -= m.lti.bf[b] * jp;
+        VecX z = y.template head<NX>();
+        m.lti.impulse(z, -jp);  // the floor takes the opposite impulse
+        y.template head<NX>() = z;
         y(NX + 2) += S(0.5) * dm.m_star * (S(1) - e * e) * v_app * v_app;
         if (v_app > static_cast<S>(kStickSpeed)) ++d.count.contacts;
         if (plastic) {
@@ -376,7 +363,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
         if (tau == hi && hi - lo <= S(4) * std::numeric_limits<S>::epsilon() * (t + hi)) break;
       }
       // Accept up to the event.
-      track_substep(m, d, st.mode, y, rr.y, tau);
+      track_substep(m, d, st.mode, y, rr.y, tau, d.time(m) + static_cast<double>(t + tau));
       t += tau;
       y = rr.y;
       ++d.count.substeps;
@@ -388,7 +375,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
 
     // Plain accepted sub-step.
-    track_substep(m, d, st.mode, y, r.y, hs);
+    track_substep(m, d, st.mode, y, r.y, hs, d.time(m) + static_cast<double>(t + hs));
     t += hs;
     y = r.y;
     f = r.f;
@@ -413,8 +400,6 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   S fp, loss;
   st.force(y, h, &fp, &loss);
   d.contact_force = fp;
-  d.x = m.floor_x(d.z);
-  d.v = m.floor_v(d.z);
 }
 
 }  // namespace vines

@@ -1,0 +1,180 @@
+#include "sim_host/bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+
+#include "sim_host/engine.hpp"
+#include "sim_host/run.hpp"
+
+namespace vines::host {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double rel(double a, double b) { return b != 0.0 ? std::fabs(a - b) / std::fabs(b) : kNaN; }
+
+// A built engine for the scene, or a runtime_error naming the scene key.
+std::unique_ptr<Engine> built_engine(const Scene& scene, const SceneParams& p, Scalar scalar) {
+  std::unique_ptr<Engine> eng = make_engine(p, scalar);
+  if (!eng)
+    throw std::runtime_error(scene.path + ": frame.stories: this build has frames of " +
+                             std::string(compiled_story_counts()) + " stories");
+  const ParamError e = eng->build(p);
+  if (!e.ok()) throw std::runtime_error(scene.path + ": " + std::string(e.field) + ": " + e.message);
+  return eng;
+}
+
+RunTotals run_once(Engine& eng, const std::vector<double>& a) {
+  eng.init(a[0]);
+  for (std::size_t k = 1; k < a.size(); ++k) eng.step(a[k]);
+  return eng.totals();
+}
+
+// One firmware line: the scene at one scalar, rate and tolerance.
+BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, const Truth& truth,
+                        const BenchOptions& opt) {
+  Scene scene = base;
+  scene.scalar = scalar;
+  scene.params.loop.sensor_rate_hz = rate;
+  scene.params.loop.contact_rtol = rtol;
+  if (!opt.full_outputs) {
+    scene.params.loop.floor_peaks = false;
+    scene.params.loop.energy_ledger = false;
+  }
+  const Excitation ex = load_excitation(scene, "");
+
+  BenchLine l;
+  l.scene = scene.name;
+  l.method = "firmware";
+  l.scalar = scalar_name(scalar);
+  l.rate_hz = rate;
+  l.rtol = rtol;
+  const auto b0 = std::chrono::steady_clock::now();
+  std::unique_ptr<Engine> eng = built_engine(scene, scene.params, scalar);
+  l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
+
+  // Timed runs: median wall time of whole runs (init + every step).
+  std::vector<double> walls;
+  double total = 0;
+  RunTotals t;
+  while ((total < opt.min_time_s || static_cast<int>(walls.size()) < opt.min_runs) && walls.size() < 10000) {
+    const auto t0 = std::chrono::steady_clock::now();
+    t = run_once(*eng, ex.samples);
+    walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    total += walls.back();
+  }
+  std::sort(walls.begin(), walls.end());
+  l.runs = static_cast<int>(walls.size());
+  l.wall_median_s = walls[walls.size() / 2];
+  l.wall_min_s = walls.front();
+  l.steps = t.count.steps;
+  l.substeps = t.count.substeps;
+  l.rejected = t.count.rejected;
+  l.peak_top = t.peak_top;
+  l.elastic_energy = t.elastic_energy;
+  l.contacts = static_cast<int>(t.count.contacts);
+  l.x_r = kNaN;
+  if (scene.params.device.kind != DeviceKind::kNone) {
+    SceneParams pb = scene.params;
+    pb.device.kind = DeviceKind::kNone;
+    const RunTotals b = run_once(*built_engine(scene, pb, scalar), ex.samples);
+    l.x_r = (b.peak_top - t.peak_top) / b.peak_top;
+  }
+  l.peak_rel_error = truth.known ? rel(l.peak_top, truth.peak_top) : kNaN;
+  l.elastic_energy_rel_error = truth.known ? rel(l.elastic_energy, truth.elastic_energy) : kNaN;
+  l.x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l.x_r - truth.x_r) : kNaN;
+  return l;
+}
+
+}  // namespace
+
+Truth load_truth(const Scene& scene, const std::string& reference_dir) {
+  const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);
+  const fs::path file = dir / (scene.name + ".json");
+  Truth t;
+  if (!fs::is_regular_file(file)) return t;
+  try {
+    const json j = json::parse(std::ifstream(file));
+    t.peak_top = j.at("peak_top_displacement_m").get<double>();
+    t.elastic_energy = j.at("elastic_energy_Js").get<double>();
+    t.contacts = j.at("contacts").get<int>();
+    if (j.contains("x_r") && !j["x_r"].is_null()) {
+      t.has_x_r = true;
+      t.x_r = j["x_r"].get<double>();
+      t.E_r = j.at("E_r").get<double>();
+    }
+  } catch (const std::exception& e) {
+    throw std::runtime_error(file.string() + ": not a reference file: " + e.what());
+  }
+  t.known = true;
+  t.source = file.string();
+  return t;
+}
+
+std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) {
+  const Truth truth = load_truth(scene, opt.reference_dir);
+  std::vector<Scalar> scalars;
+  for (const std::string& s : opt.scalars.empty() ? std::vector<std::string>{"double", "float"} : opt.scalars) {
+    if (s != "double" && s != "float") throw std::runtime_error("--scalars: unknown scalar '" + s + "'");
+    scalars.push_back(s == "float" ? Scalar::kFloat : Scalar::kDouble);
+  }
+  const std::vector<double> rates = opt.rates_hz.empty() ? std::vector<double>{scene.params.loop.sensor_rate_hz} : opt.rates_hz;
+  // The tolerance only matters when there is a contact law to sub-step.
+  const bool contacts = scene.params.device.kind == DeviceKind::kVines;
+  const std::vector<double> rtols = opt.rtols.empty() || !contacts ? std::vector<double>{scene.params.loop.contact_rtol} : opt.rtols;
+  std::vector<BenchLine> lines;
+  for (Scalar s : scalars)
+    for (double rate : rates)
+      for (double rtol : rtols) lines.push_back(firmware_line(scene, s, rate, rtol, truth, opt));
+  return lines;
+}
+
+json line_json(const BenchLine& l) {
+  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"scene", l.scene},
+          {"method", l.method},
+          {"scalar", l.scalar},
+          {"sensor_rate_hz", l.rate_hz},
+          {"contact_rtol", l.rtol},
+          {"runs", l.runs},
+          {"wall_s_median", l.wall_median_s},
+          {"wall_s_min", l.wall_min_s},
+          {"build_s", l.build_s},
+          {"steps", l.steps},
+          {"substeps", l.substeps},
+          {"rejected_substeps", l.rejected},
+          {"peak_top_displacement_m", l.peak_top},
+          {"elastic_energy_Js", l.elastic_energy},
+          {"x_r", num(l.x_r)},
+          {"contacts", l.contacts},
+          {"peak_rel_error", num(l.peak_rel_error)},
+          {"elastic_energy_rel_error", num(l.elastic_energy_rel_error)},
+          {"x_r_abs_error", num(l.x_r_abs_error)}};
+}
+
+std::string format_table(const std::vector<BenchLine>& lines) {
+  std::string out;
+  char buf[320];
+  std::snprintf(buf, sizeof buf, "%-26s %-12s %-6s %8s %7s %10s %5s %8s %8s %9s %9s %9s %8s\n", "scene", "method",
+                "scalar", "rate_hz", "rtol", "wall_ms", "runs", "steps", "substeps", "peak_err", "Ee_err",
+                "x_r_err", "contacts");
+  out += buf;
+  for (const BenchLine& l : lines) {
+    std::snprintf(buf, sizeof buf, "%-26s %-12s %-6s %8.0f %7.0e %10.4f %5d %8lld %8lld %9.2e %9.2e %9.2e %8d\n",
+                  l.scene.c_str(), l.method.c_str(), l.scalar.c_str(), l.rate_hz, l.rtol, 1e3 * l.wall_median_s,
+                  l.runs, l.steps, l.substeps, l.peak_rel_error, l.elastic_energy_rel_error, l.x_r_abs_error,
+                  l.contacts);
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace vines::host
