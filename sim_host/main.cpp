@@ -14,6 +14,7 @@
 #include <fstream>
 
 #include "sim_host/design.hpp"
+#include "sim_host/reference/report.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/sweep.hpp"
@@ -38,6 +39,10 @@ constexpr const char* kUsage =
     "  design SCENE.toml --optimize beta|eps|mass_ratio|TABLE.KEY [options]\n"
     "      Best value of one design parameter for the scene's record or a set of\n"
     "      records (mean or worst case): coarse grid, then golden-section refinement.\n"
+    "  reference SCENE.toml [--rtol R] [--out FILE]\n"
+    "      Integrate the scene and its bare frame with the converged reference\n"
+    "      (DOP853 in long double, events located to rounding) at rtol R and 100 R;\n"
+    "      writes FILE (default: data/reference/<scene name>.json).\n"
     "  help [COMMAND]\n"
     "      This text.\n"
     "\n"
@@ -78,6 +83,15 @@ constexpr const char* kDesignUsage =
     "  --metric          x_r (default) or E_r, maximised\n"
     "  --coarse N        coarse grid points (default 21); --refine N golden steps (12)\n"
     "  --out DIR         writes DIR/design.json (default: out/design_<scene name>)\n";
+
+constexpr const char* kReferenceUsage =
+    "usage: vines reference SCENE.toml [--rtol R] [--out FILE] [--quiet]\n"
+    "\n"
+    "  SCENE.toml  scene file (see data/scenes/README.md); its record at its sensor rate\n"
+    "  --rtol R    relative tolerance of the reference (default 1e-15, range 1e-17 to\n"
+    "              1e-2); the convergence check repeats every run at 100 R\n"
+    "  --out FILE  JSON output (default: data/reference/<scene name>.json)\n"
+    "  --quiet     print nothing but errors\n";
 
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
@@ -211,6 +225,67 @@ int cmd_design(const std::vector<std::string>& args) {
   }
 }
 
+int cmd_reference(const std::vector<std::string>& args) {
+  using namespace vines::host;
+  std::string scene_path, out;
+  double rtol = 0.0;
+  bool quiet = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kReferenceUsage, stdout);
+      return 0;
+    } else if (a == "--rtol" || a == "--out") {
+      if (i + 1 >= args.size()) return usage_error(kReferenceUsage, a + " needs a value");
+      const std::string& v = args[++i];
+      if (a == "--out") {
+        out = v;
+      } else {
+        char* end = nullptr;
+        rtol = std::strtod(v.c_str(), &end);
+        if (*end != '\0' || !(rtol > 0.0)) return usage_error(kReferenceUsage, "--rtol takes a number > 0, got " + v);
+      }
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error(kReferenceUsage, "unknown option " + a);
+    } else if (scene_path.empty()) {
+      scene_path = a;
+    } else {
+      return usage_error(kReferenceUsage, "more than one scene given");
+    }
+  }
+  if (scene_path.empty()) return usage_error(kReferenceUsage, "no scene given");
+  try {
+    const Scene scene = load_scene(scene_path);
+    if (out.empty()) out = "data/reference/" + scene.name + ".json";
+    const nlohmann::json j = reference::reference_report(scene, rtol);
+    const std::filesystem::path file(out);
+    std::error_code ec;
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
+    std::ofstream f(file);
+    if (ec || !(f << j.dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
+    if (!quiet) {
+      const nlohmann::json& c = j["convergence"];
+      std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), j["rtol"].get<double>(),
+                  j["steps"].get<long long>(), j["wall_s"].get<double>());
+      std::printf("  peak top displacement %.12f m at t = %.6f s; E_e %.10e J s; contacts %d\n",
+                  j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>(),
+                  j["elastic_energy_Js"].get<double>(), j["contacts"].get<int>());
+      std::printf("  x_r = %.4f %%   E_r = %.4f %%   (bare peak %.12f m)\n", 100 * j["x_r"].get<double>(),
+                  100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
+      std::printf("  convergence vs rtol %.0e: peak %.1e, E_e %.1e (relative), contacts %s; written to %s\n",
+                  c["rtol_coarse"].get<double>(), c["peak_rel_diff"].get<double>(),
+                  c["elastic_energy_rel_diff"].get<double>(), c["contacts_equal"].get<bool>() ? "equal" : "DIFFER",
+                  out.c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vines reference: %s\n", e.what());
+    return 1;
+  }
+}
+
 std::atomic<bool> g_stop{false};
 
 int cmd_sweep(const std::vector<std::string>& args) {
@@ -296,10 +371,12 @@ int main(int argc, char** argv) {
   if (cmd == "run") return cmd_run(args);
   if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "design") return cmd_design(args);
+  if (cmd == "reference") return cmd_reference(args);
   if (cmd == "help" || cmd == "-h" || cmd == "--help") {
     if (!args.empty() && args[0] == "run") std::fputs(kRunUsage, stdout);
     else if (!args.empty() && args[0] == "sweep") std::fputs(kSweepUsage, stdout);
     else if (!args.empty() && args[0] == "design") std::fputs(kDesignUsage, stdout);
+    else if (!args.empty() && args[0] == "reference") std::fputs(kReferenceUsage, stdout);
     else std::fputs(kUsage, stdout);
     return 0;
   }
