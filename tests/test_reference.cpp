@@ -258,11 +258,14 @@ TEST(ReferenceSlow, ConvergesOnTheVinesPeak) {
 
 // The firmware loop at its default settings (1 kHz) against the reference.
 struct LoopCase {
+  const char* name;
   DeviceKind kind;
   ContactLaw law;
   double energy_tol;    // VI NES E_e is chaotic (MODEL.md): loose
   double count_rtol;    // > 0: compare the contact count at this loop.contact_rtol
 };
+
+void PrintTo(const LoopCase& c, std::ostream* os) { *os << c.name; }
 
 class ReferenceSlowLoop : public ::testing::TestWithParam<LoopCase> {};
 
@@ -292,12 +295,13 @@ INSTANTIATE_TEST_SUITE_P(
     // the chaos after ~33 s, ends in a cascade of 7 bounces on the right wall
     // from 48.74 s (26 contacts) where the converged motion has 6 from
     // 48.65 s (25); at 1e-12 the loop gives 25 too.
-    ::testing::Values(LoopCase{DeviceKind::kNone, ContactLaw::kKuwabara, 1e-9, 0},
-                      LoopCase{DeviceKind::kTmd, ContactLaw::kKuwabara, 1e-9, 0},
-                      LoopCase{DeviceKind::kVines, ContactLaw::kKuwabara, 1e-3, 0},
-                      LoopCase{DeviceKind::kVines, ContactLaw::kTsuji, 1e-3, 1e-12},
-                      LoopCase{DeviceKind::kVines, ContactLaw::kHertz, 1e-3, 0},
-                      LoopCase{DeviceKind::kVines, ContactLaw::kRestitution, 1e-3, 0}));
+    ::testing::Values(LoopCase{"bare", DeviceKind::kNone, ContactLaw::kKuwabara, 1e-9, 0},
+                      LoopCase{"tmd", DeviceKind::kTmd, ContactLaw::kKuwabara, 1e-9, 0},
+                      LoopCase{"kuwabara", DeviceKind::kVines, ContactLaw::kKuwabara, 1e-3, 0},
+                      LoopCase{"tsuji", DeviceKind::kVines, ContactLaw::kTsuji, 1e-3, 1e-12},
+                      LoopCase{"hertz", DeviceKind::kVines, ContactLaw::kHertz, 1e-3, 0},
+                      LoopCase{"restitution", DeviceKind::kVines, ContactLaw::kRestitution, 1e-3, 0}),
+    [](const ::testing::TestParamInfo<LoopCase>& i) { return std::string(i.param.name); });
 
 TEST(ReferenceSlow, StoredFilesEqualAFreshRun) {
   for (const char* name : {"elcentro_bare", "elcentro_tmd", "elcentro_vines", "elcentro_vines_tsuji",
