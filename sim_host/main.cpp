@@ -88,8 +88,8 @@ constexpr const char* kReferenceUsage =
     "usage: vines reference SCENE.toml [--rtol R] [--out FILE] [--quiet]\n"
     "\n"
     "  SCENE.toml  scene file (see data/scenes/README.md); its record at its sensor rate\n"
-    "  --rtol R    relative tolerance of the reference (default 1e-15, range 1e-17 to\n"
-    "              1e-2); the convergence check repeats every run at 100 R\n"
+    "  --rtol R    relative tolerance of the reference (default 1e-15, from 1e-17 to\n"
+    "              1e-4); the convergence check repeats every run at 100 R\n"
     "  --out FILE  JSON output (default: data/reference/<scene name>.json)\n"
     "  --quiet     print nothing but errors\n";
 
@@ -243,7 +243,8 @@ int cmd_reference(const std::vector<std::string>& args) {
       } else {
         char* end = nullptr;
         rtol = std::strtod(v.c_str(), &end);
-        if (*end != '\0' || !(rtol > 0.0)) return usage_error(kReferenceUsage, "--rtol takes a number > 0, got " + v);
+        if (*end != '\0' || !(rtol >= 1e-17 && rtol <= 1e-4))
+          return usage_error(kReferenceUsage, "--rtol takes a number from 1e-17 to 1e-4, got " + v);
       }
     } else if (a == "--quiet") {
       quiet = true;
