@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "sim_host/engine.hpp"
+#include "sim_host/reference/truth.hpp"
 #include "sim_host/run.hpp"
 
 namespace vines::host {
@@ -94,6 +95,45 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   return l;
 }
 
+// One baseline line: CVODE on the record's own points.
+BenchLine baseline_line(const Scene& base, reference::Method method, double rtol, const Truth& truth,
+                        const BenchOptions& opt) {
+  Scene scene = base;
+  const hal::Record rec = load_excitation(scene, "").record;
+  scene.params.loop.sensor_rate_hz = 1.0 / rec.dt_s;
+  const Excitation ex = load_excitation(scene, "");
+  BenchLine l;
+  l.scene = scene.name;
+  l.method = method == reference::Method::kCvodeAdams ? "cvode-adams" : "cvode-bdf";
+  l.scalar = "double";
+  l.rate_hz = ex.rate_hz;
+  l.rtol = rtol;
+  reference::Options o;
+  o.rtol = rtol;
+  std::vector<double> walls;
+  double total = 0;
+  reference::Result r;
+  while ((total < opt.min_time_s || static_cast<int>(walls.size()) < opt.min_runs) && walls.size() < 1000) {
+    r = reference::integrate(scene.params, ex.samples, ex.rate_hz, method, o);
+    walls.push_back(r.wall_s);
+    total += r.wall_s;
+  }
+  std::sort(walls.begin(), walls.end());
+  l.runs = static_cast<int>(walls.size());
+  l.wall_median_s = walls[walls.size() / 2];
+  l.wall_min_s = walls.front();
+  l.steps = r.steps;
+  l.rejected = r.rejected;
+  l.peak_top = r.peak_top;
+  l.elastic_energy = r.elastic_energy;
+  l.contacts = r.contacts;
+  l.x_r = truth.has_x_r ? (truth.bare_peak_top - r.peak_top) / truth.bare_peak_top : kNaN;
+  l.peak_rel_error = truth.known ? rel(l.peak_top, truth.peak_top) : kNaN;
+  l.elastic_energy_rel_error = truth.known ? rel(l.elastic_energy, truth.elastic_energy) : kNaN;
+  l.x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l.x_r - truth.x_r) : kNaN;
+  return l;
+}
+
 }  // namespace
 
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
@@ -110,6 +150,8 @@ Truth load_truth(const Scene& scene, const std::string& reference_dir) {
       t.has_x_r = true;
       t.x_r = j["x_r"].get<double>();
       t.E_r = j.at("E_r").get<double>();
+      t.bare_peak_top = j.at("bare").at("peak_top_displacement_m").get<double>();
+      t.bare_elastic_energy = j.at("bare").at("elastic_energy_Js").get<double>();
     }
   } catch (const std::exception& e) {
     throw std::runtime_error(file.string() + ": not a reference file: " + e.what());
@@ -134,6 +176,8 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   for (Scalar s : scalars)
     for (double rate : rates)
       for (double rtol : rtols) lines.push_back(firmware_line(scene, s, rate, rtol, truth, opt));
+  for (reference::Method m : {reference::Method::kCvodeAdams, reference::Method::kCvodeBdf})
+    for (double rtol : opt.baseline_rtols) lines.push_back(baseline_line(scene, m, rtol, truth, opt));
   return lines;
 }
 

@@ -50,6 +50,9 @@ struct BenchOptions {
   // contacts), as a study does. On: the scene's own outputs (per-floor
   // peaks, energy ledger) are computed too.
   bool full_outputs = false;
+  // SUNDIALS CVODE (Adams and BDF) on the same model at these tolerances, fed
+  // the record's own points (the same piecewise-linear input); empty: none.
+  std::vector<double> baseline_rtols;
 };
 
 // The scene's reference, or an unknown truth if there is none on file.

@@ -15,6 +15,7 @@
 
 #include "sim_host/bench.hpp"
 #include "sim_host/design.hpp"
+#include "sim_host/reference/report.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/sweep.hpp"
@@ -42,6 +43,10 @@ constexpr const char* kUsage =
     "  bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST] [--json]\n"
     "      Speed against accuracy: wall time of full runs and their error against the\n"
     "      converged reference (data/reference), per sensor rate, tolerance and scalar.\n"
+    "  reference SCENE.toml [--rtol R] [--out FILE]\n"
+    "      Integrate the scene and its bare frame with the converged reference\n"
+    "      (DOP853 in long double, events located to rounding) at rtol R and 100 R;\n"
+    "      writes FILE (default: data/reference/<scene name>.json).\n"
     "  help [COMMAND]\n"
     "      This text.\n"
     "\n"
@@ -85,7 +90,8 @@ constexpr const char* kDesignUsage =
 
 constexpr const char* kBenchUsage =
     "usage: vines bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
-    "                   [--min-time S] [--reference DIR] [--full-outputs] [--json] [--csv FILE]\n"
+    "                   [--baselines LIST | --no-baselines] [--min-time S] [--reference DIR]\n"
+    "                   [--full-outputs] [--json] [--csv FILE]\n"
     "\n"
     "  Times full runs of each scene (record loaded, model built; median of repeats)\n"
     "  and compares them with the scene's reference (DIR/<scene name>.json, default\n"
@@ -93,11 +99,22 @@ constexpr const char* kBenchUsage =
     "  --rates LIST    sensor rates [Hz], comma-separated (default: the scene's)\n"
     "  --rtols LIST    contact sub-step tolerances (default: the scene's)\n"
     "  --scalars LIST  double,float (default: the scene's scalar)\n"
+    "  --baselines LIST  SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the\n"
+    "                  record's own points (default 1e-6,1e-8,1e-10; none with --json)\n"
+    "  --no-baselines  no CVODE lines\n"
     "  --min-time S    time each line for at least S seconds (default 0.3)\n"
     "  --full-outputs  also compute the scene's per-floor peaks and energy ledger\n"
     "                  (default: only what the table needs, as a study run does)\n"
     "  --json          print JSON: one object for a single line, else {\"lines\": [...]}\n"
     "  --csv FILE      also write the lines as CSV\n";
+constexpr const char* kReferenceUsage =
+    "usage: vines reference SCENE.toml [--rtol R] [--out FILE] [--quiet]\n"
+    "\n"
+    "  SCENE.toml  scene file (see data/scenes/README.md); its record at its sensor rate\n"
+    "  --rtol R    relative tolerance of the reference (default 1e-15, from 1e-17 to\n"
+    "              1e-4); the convergence check repeats every run at 100 R\n"
+    "  --out FILE  JSON output (default: data/reference/<scene name>.json)\n"
+    "  --quiet     print nothing but errors\n";
 
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
@@ -251,7 +268,7 @@ int cmd_bench(const std::vector<std::string>& args) {
   using namespace vines::host;
   std::vector<std::string> scenes;
   BenchOptions opt;
-  bool as_json = false;
+  bool as_json = false, no_baselines = false, baselines_given = false;
   std::string csv;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -259,8 +276,8 @@ int cmd_bench(const std::vector<std::string>& args) {
       std::fputs(kBenchUsage, stdout);
       return 0;
     }
-    if (a == "--json" || a == "--full-outputs") {
-      (a == "--json" ? as_json : opt.full_outputs) = true;
+    if (a == "--json" || a == "--full-outputs" || a == "--no-baselines") {
+      (a == "--json" ? as_json : a == "--full-outputs" ? opt.full_outputs : no_baselines) = true;
       continue;
     }
     if (a.empty() || a[0] != '-') {
@@ -270,10 +287,11 @@ int cmd_bench(const std::vector<std::string>& args) {
     if (i + 1 >= args.size()) return usage_error(kBenchUsage, a + " needs a value");
     const std::string& v = args[++i];
     std::vector<double> xs;
-    if (a == "--rates" || a == "--rtols" || a == "--min-time") {
+    if (a == "--rates" || a == "--rtols" || a == "--min-time" || a == "--baselines") {
       if (!number_list(v, &xs)) return usage_error(kBenchUsage, a + ": not a list of positive numbers: " + v);
       if (a == "--rates") opt.rates_hz = xs;
       else if (a == "--rtols") opt.rtols = xs;
+      else if (a == "--baselines") opt.baseline_rtols = xs, baselines_given = true;
       else opt.min_time_s = xs[0];
     } else if (a == "--scalars") {
       for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
@@ -290,6 +308,9 @@ int cmd_bench(const std::vector<std::string>& args) {
     }
   }
   if (scenes.empty()) return usage_error(kBenchUsage, "no scene given");
+  // The table has CVODE baselines by default; --json alone is the scene's own line.
+  if (!baselines_given && !as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
+  if (no_baselines) opt.baseline_rtols.clear();
   try {
     std::vector<BenchLine> lines;
     for (const std::string& path : scenes) {
@@ -328,6 +349,68 @@ int cmd_bench(const std::vector<std::string>& args) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vines bench: %s\n", e.what());
+    return 1;
+  }
+}
+
+int cmd_reference(const std::vector<std::string>& args) {
+  using namespace vines::host;
+  std::string scene_path, out;
+  double rtol = 0.0;
+  bool quiet = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kReferenceUsage, stdout);
+      return 0;
+    } else if (a == "--rtol" || a == "--out") {
+      if (i + 1 >= args.size()) return usage_error(kReferenceUsage, a + " needs a value");
+      const std::string& v = args[++i];
+      if (a == "--out") {
+        out = v;
+      } else {
+        char* end = nullptr;
+        rtol = std::strtod(v.c_str(), &end);
+        if (*end != '\0' || !(rtol >= 1e-17 && rtol <= 1e-4))
+          return usage_error(kReferenceUsage, "--rtol takes a number from 1e-17 to 1e-4, got " + v);
+      }
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error(kReferenceUsage, "unknown option " + a);
+    } else if (scene_path.empty()) {
+      scene_path = a;
+    } else {
+      return usage_error(kReferenceUsage, "more than one scene given");
+    }
+  }
+  if (scene_path.empty()) return usage_error(kReferenceUsage, "no scene given");
+  try {
+    const Scene scene = load_scene(scene_path);
+    if (out.empty()) out = "data/reference/" + scene.name + ".json";
+    const nlohmann::json j = reference::reference_report(scene, rtol);
+    const std::filesystem::path file(out);
+    std::error_code ec;
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
+    std::ofstream f(file);
+    if (ec || !(f << j.dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
+    if (!quiet) {
+      const nlohmann::json& c = j["convergence"];
+      std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), j["rtol"].get<double>(),
+                  j["steps"].get<long long>(), j["wall_s"].get<double>());
+      std::printf("  peak top displacement %.12f m at t = %.6f s; E_e %.10e J s; contacts %d\n",
+                  j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>(),
+                  j["elastic_energy_Js"].get<double>(), j["contacts"].get<int>());
+      std::printf("  x_r = %.4f %%   E_r = %.4f %%   (bare peak %.12f m)\n", 100 * j["x_r"].get<double>(),
+                  100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
+      std::printf("  convergence vs rtol %.0e: peak %.1e, E_e %.1e (relative), contacts %s; written to %s\n",
+                  c["rtol_coarse"].get<double>(), c["peak_rel_diff"].get<double>(),
+                  c["elastic_energy_rel_diff"].get<double>(), c["contacts_equal"].get<bool>() ? "equal" : "DIFFER",
+                  out.c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vines reference: %s\n", e.what());
     return 1;
   }
 }
@@ -418,11 +501,13 @@ int main(int argc, char** argv) {
   if (cmd == "sweep") return cmd_sweep(args);
   if (cmd == "design") return cmd_design(args);
   if (cmd == "bench") return cmd_bench(args);
+  if (cmd == "reference") return cmd_reference(args);
   if (cmd == "help" || cmd == "-h" || cmd == "--help") {
     if (!args.empty() && args[0] == "run") std::fputs(kRunUsage, stdout);
     else if (!args.empty() && args[0] == "sweep") std::fputs(kSweepUsage, stdout);
     else if (!args.empty() && args[0] == "design") std::fputs(kDesignUsage, stdout);
     else if (!args.empty() && args[0] == "bench") std::fputs(kBenchUsage, stdout);
+    else if (!args.empty() && args[0] == "reference") std::fputs(kReferenceUsage, stdout);
     else std::fputs(kUsage, stdout);
     return 0;
   }

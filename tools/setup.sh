@@ -14,6 +14,7 @@ packages=(
   qemu-system-arm                                # runs the MCU image
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
+  libsundials-dev                                # CVODE baseline (vines reference, tests)
 )
 
 missing=()

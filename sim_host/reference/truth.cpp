@@ -1,0 +1,69 @@
+#include "sim_host/reference/truth.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "sim_host/reference/integrators.hpp"
+
+namespace vines::host::reference {
+namespace {
+
+// Tolerances each method can honour: the reference well above long-double
+// rounding, CVODE well above double rounding.
+constexpr double kReferenceDefault = 1e-15, kReferenceMin = 1e-17;
+constexpr double kCvodeDefault = 1e-8, kCvodeMin = 1e-13;
+constexpr double kMaxRtol = 1e-2;
+
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+Ground check_ground(const std::vector<double>& samples, double rate_hz, double duration_s) {
+  if (samples.size() < 2)
+    throw std::runtime_error("ground samples: need at least 2, got " + std::to_string(samples.size()));
+  if (!(std::isfinite(rate_hz) && rate_hz > 0.0)) throw std::runtime_error("sample rate must be > 0, got " + num(rate_hz));
+  for (std::size_t k = 0; k < samples.size(); ++k)
+    if (!std::isfinite(samples[k])) throw std::runtime_error("ground sample " + std::to_string(k) + " is not finite");
+  if (!(std::isfinite(duration_s) && duration_s >= 0.0))
+    throw std::runtime_error("duration must be >= 0 (0: all samples), got " + num(duration_s));
+  Ground g;
+  g.samples = &samples;
+  g.rate_hz = rate_hz;
+  const double full = static_cast<double>(samples.size() - 1) / rate_hz;
+  g.t_end = duration_s > 0.0 ? std::fmin(duration_s, full) : full;
+  // Intervals that reach t_end (the last one may be cut short).
+  g.intervals = static_cast<int>(std::ceil(g.t_end * rate_hz * (1.0 - 1e-12)));
+  if (g.intervals < 1) g.intervals = 1;
+  return g;
+}
+
+}  // namespace
+
+const char* method_name(Method m) {
+  switch (m) {
+    case Method::kReference: return "reference (DOP853, long double)";
+    case Method::kCvodeAdams: return "CVODE Adams (fixed point)";
+    default: return "CVODE BDF (Newton, dense)";
+  }
+}
+
+Result integrate(const SceneParams& p, const std::vector<double>& samples, double sample_rate_hz, Method m,
+                 const Options& o) {
+  const Ground g = check_ground(samples, sample_rate_hz, o.duration_s);
+  const bool ref = m == Method::kReference;
+  const double rtol = o.rtol > 0.0 ? o.rtol : ref ? kReferenceDefault : kCvodeDefault;
+  const double lo = ref ? kReferenceMin : kCvodeMin;
+  if (!(rtol >= lo && rtol <= kMaxRtol))
+    throw std::runtime_error(std::string("rtol ") + num(o.rtol) + " out of range for " + method_name(m) + ": [" +
+                             num(lo) + ", " + num(kMaxRtol) + "]");
+  const OdeSpec spec = make_spec(p);
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = ref ? integrate_reference(spec, g, rtol) : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace vines::host::reference

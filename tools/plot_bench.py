@@ -1,0 +1,82 @@
+#!/usr/bin/python3
+"""Plot `vines bench --csv` output: error of the peak top displacement against
+wall time per full run (log-log), one panel per scene, one series per method,
+scalar and sensor rate (the points of a series are its tolerances).
+
+Usage: plot_bench.py BENCH.csv [--out FILE.png]
+Exit code 2, with a message naming the path, on a missing file or column.
+"""
+import argparse
+import csv
+import sys
+from collections import defaultdict
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+COLUMNS = ["scene", "method", "scalar", "sensor_rate_hz", "contact_rtol", "wall_s_median", "peak_rel_error"]
+FLOOR = 1e-16  # errors below this are drawn at it (log scale)
+
+
+def load(path):
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        sys.exit(f"plot_bench.py: {path}: {e.strerror}")
+    for c in COLUMNS:
+        if rows and c not in rows[0]:
+            sys.exit(f"plot_bench.py: {path}: no column '{c}'")
+    return rows
+
+
+def number(v):
+    try:
+        return float(v)
+    except ValueError:
+        return float("nan")  # null in the CSV: no truth for that line
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("csv")
+    ap.add_argument("--out", default="work_precision.png")
+    a = ap.parse_args()
+    rows = load(a.csv)
+    if not rows:
+        sys.exit(f"plot_bench.py: {a.csv}: no lines")
+    scenes = sorted({r["scene"].strip('"') for r in rows})
+    cols = min(3, len(scenes))
+    nrows = (len(scenes) + cols - 1) // cols
+    fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.2 * nrows), squeeze=False)
+    for ax, scene in zip(axes.flat, scenes):
+        series = defaultdict(list)
+        for r in rows:
+            if r["scene"].strip('"') != scene:
+                continue
+            err = number(r["peak_rel_error"])
+            if err != err:
+                continue
+            key = (r["method"].strip('"'), r["scalar"].strip('"'), number(r["sensor_rate_hz"]))
+            series[key].append((number(r["wall_s_median"]), max(err, FLOOR)))
+        for (method, scalar, rate), pts in sorted(series.items()):
+            pts.sort()
+            label = f"{method} {scalar}" + (f" {rate:g} Hz" if method == "firmware" else "")
+            style = "o-" if method == "firmware" else "s--"
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, ms=4, label=label)
+        ax.axhline(1e-6, color="grey", lw=0.8, ls=":")
+        ax.set_title(scene)
+        ax.set_xlabel("wall time per full run [s]")
+        ax.set_ylabel("peak top displacement, relative error")
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend(fontsize=6)
+    for ax in list(axes.flat)[len(scenes):]:
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(a.out, dpi=130)
+    print(f"plot_bench.py: wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()
