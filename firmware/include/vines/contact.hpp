@@ -42,6 +42,9 @@ inline double tsuji_d(double eps) {
   return -std::sqrt(5.0) * l / std::sqrt(l * l + kPi * kPi);
 }
 
+// Each law also gives its force in terms of q = d^{1/4} (regular(q, dd)):
+// a polynomial in q, what the loop integrates contacts in (substep.hpp).
+
 // F = C d^{3/2}.
 template <typename S>
 struct Hertz {
@@ -49,6 +52,10 @@ struct Hertz {
   Force<S> operator()(S d, S /*dd*/) const {
     using std::sqrt;
     return {c * d * sqrt(d), S(0)};
+  }
+  Force<S> regular(S q, S /*dd*/) const {
+    const S q2 = q * q;
+    return {c * q2 * q2 * q2, S(0)};
   }
 };
 
@@ -62,6 +69,10 @@ struct Tsuji {
     const S sd = sqrt(d);
     return {c * d * sd, g * sqrt(sd) * dd};
   }
+  Force<S> regular(S q, S dd) const {
+    const S q2 = q * q;
+    return {c * q2 * q2 * q2, g * q * dd};
+  }
 };
 
 // Kuwabara-Kono: F = C d^{3/2} + (3/2) C tau d^{1/2} dd, with g = 1.5 C tau.
@@ -73,6 +84,10 @@ struct Kuwabara {
     using std::sqrt;
     const S sd = sqrt(d);
     return {c * d * sd, g * sd * dd};
+  }
+  Force<S> regular(S q, S dd) const {
+    const S q2 = q * q;
+    return {c * q2 * q2 * q2, g * q2 * dd};
   }
 };
 

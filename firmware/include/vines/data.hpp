@@ -60,7 +60,9 @@ struct Data {
   // VI NES particle: s = displacement from its start (relative to ground).
   S s = S(0), sd = S(0);
   Mode mode = Mode::kFree;
-  S substep = S(0);         // last sub-step size (carried across steps)
+  S substep = S(0);         // last sub-step size in t (carried across steps)
+  S substep_w = S(0);       // last sub-step size in w inside a contact
+  S q = S(0);               // overlap^{1/4} of the current contact
   S contact_force = S(0);   // on the particle, positive to the right
   S contact_depth = S(0);   // deepest overlap of the current contact
   S max_overlap = S(0);     // deepest overlap of the run

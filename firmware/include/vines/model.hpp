@@ -53,8 +53,10 @@ struct DeviceModel<S, VinesDevice<L>> {
                      std::conditional_t<L == ContactLaw::kKuwabara, contact::Kuwabara<S>,
                                         contact::Hertz<S>>>
       law;
-  // Error scales of the sub-stepper: a position and a speed typical of contacts.
-  S pos_scale, vel_scale, modal_scale;
+  // Error scales of the sub-stepper: a position and a speed typical of
+  // contacts, q = d^{1/4} of that position, and a first step in w (q moves
+  // by ~2 % of its scale).
+  S pos_scale, vel_scale, modal_scale, q_scale, w_step0;
   // Contacts shallower than this are not counted: the scene's depth, but no
   // less than what the scalar resolves across the box (rounding fakes them).
   S count_depth;
@@ -304,6 +306,8 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));
     dm.vel_scale = static_cast<S>(v_scale);
     dm.modal_scale = static_cast<S>(std::sqrt(md.frame.m.sum()));
+    dm.q_scale = static_cast<S>(std::pow(static_cast<double>(dm.pos_scale), 0.25));
+    dm.w_step0 = static_cast<S>(0.02 * std::pow(static_cast<double>(dm.pos_scale), 0.25) / v_scale);
     const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
     dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));
   }

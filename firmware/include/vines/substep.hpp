@@ -3,8 +3,16 @@
 //     of its inertial load);
 //   - substep_through: adaptive Dormand-Prince sub-steps over the step with
 //     the frame in modal coordinates, contact starts and ends located to
-//     rounding (the contact force is not smooth there), impacts of the
-//     instantaneous law applied at their instant, a cap on sub-steps.
+//     rounding, impacts of the instantaneous law applied at their instant, a
+//     cap on sub-steps.
+// Inside a finite-duration contact the force has d^{1/2} (Kuwabara) or
+// d^{1/4} (Tsuji) in it: in time the solution is not smooth where a contact
+// starts and ends, and an adaptive method crawls there. So contacts are
+// integrated in a regularised variable w with dt/dw = 4 q^3, q = d^{1/4}
+// carried as a state (dq/dw = d'): every law is then a polynomial in q and
+// the solution is smooth in w through the whole contact, end included (q
+// crosses zero with slope -(exit speed)). Time is a state; the end of the
+// sensor step is located as an event.
 #pragma once
 
 #include <cmath>
@@ -72,9 +80,10 @@ double free_flight_work(const Model<S, N, Dev>& m, S v0, S a0, S a1) {
 
 namespace detail {
 
-// State of the sub-stepper: [z; s; s'; contact loss; input; damping; E_e].
+// State of the sub-stepper: [z; s; s'; contact loss; input; damping; E_e;
+// t; q]: t the time since the step began, q = d^{1/4} in a contact.
 template <typename S, int NX>
-using SubVec = Eigen::Matrix<S, NX + 6, 1>;
+using SubVec = Eigen::Matrix<S, NX + 8, 1>;
 
 template <typename S, int N, typename Dev>
 struct SubStepper {
@@ -85,24 +94,28 @@ struct SubStepper {
   S a0, al;   // ground acceleration a0 + al t over the step
   Mode mode;
 
+  static constexpr int kT = NX + 6, kQ = NX + 7;
+
   S ag(S t) const { return a0 + al * t; }
+  // In a contact the independent variable is w (dt/dw = 4 q^3), else t.
+  bool regular() const { return mode == Mode::kContactLeft || mode == Mode::kContactRight; }
   S rel_pos(const Vec& y) const { return y(NX) - m.dev_x(y.template head<NX>()); }
   S rel_vel(const Vec& y) const { return y(NX + 1) - m.dev_v(y.template head<NX>()); }
 
   // Force on the particle (positive to the right) and the power lost in it.
-  void force(const Vec& y, S t, S* fp, S* loss) const {
+  // Overlap rate d' of the current contact.
+  S overlap_rate(const Vec& y) const { return mode == Mode::kContactLeft ? -rel_vel(y) : rel_vel(y); }
+
+  void force(const Vec& y, S* fp, S* loss) const {
     *fp = S(0);
     *loss = S(0);
     const auto& dm = m.dev;
-    if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
+    const S t = y(kT);
+    if (regular()) {
       if constexpr (Dev::kLaw != ContactLaw::kRestitution) {
-        const bool left = mode == Mode::kContactLeft;
-        const S r = rel_pos(y), rd = rel_vel(y);
-        const S dl = left ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
-        if (dl <= S(0)) return;
-        const S ddl = left ? -rd : rd;
-        const contact::Force<S> f = dm.law(dl, ddl);
-        *fp = left ? f.total() : -f.total();
+        const S ddl = overlap_rate(y);
+        const contact::Force<S> f = dm.law.regular(y(kQ), ddl);
+        *fp = mode == Mode::kContactLeft ? f.total() : -f.total();
         *loss = f.dissipative * ddl;
       }
     } else if (mode == Mode::kStuckLeft || mode == Mode::kStuckRight) {
@@ -114,10 +127,10 @@ struct SubStepper {
     }
   }
 
-  Vec operator()(S t, const Vec& y) const {
+  Vec operator()(S /*u*/, const Vec& y) const {
     S fp, loss;
-    force(y, t, &fp, &loss);
-    const S a = ag(t);
+    force(y, &fp, &loss);
+    const S a = ag(y(kT));
     const VecX z = y.template head<NX>();
     Vec dy;
     dy.template head<NX>() = m.lti.derivative(z, a, -fp);
@@ -131,6 +144,15 @@ struct SubStepper {
       dy(NX + 3) = dy(NX + 4) = S(0);
     }
     dy(NX + 5) = m.strain.eval(z, a);
+    if (regular()) {
+      const S q = y(kQ), dtdw = S(4) * q * q * q;
+      dy.template head<NX + 6>() *= dtdw;
+      dy(kT) = dtdw;
+      dy(kQ) = overlap_rate(y);
+    } else {
+      dy(kT) = S(1);
+      dy(kQ) = S(0);
+    }
     return dy;
   }
 
@@ -146,7 +168,10 @@ struct SubStepper {
       const S r = std::fabs(e(i)) / (rtol * (scale + mag));
       if (r > worst) worst = r;
     }
-    return worst;
+    // Time, and q in a contact.
+    const S rt = std::fabs(e(kT)) / (rtol * m.hs);
+    const S rq = regular() ? std::fabs(e(kQ)) / (rtol * dm.q_scale) : S(0);
+    return std::fmax(worst, std::fmax(rt, rq));
   }
 };
 
@@ -202,11 +227,13 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
         if (plastic) {
           st.mode = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
           S fp, loss;
-          st.force(y, S(0), &fp, &loss);
+          st.force(y, &fp, &loss);
           if ((side < 0 && fp < S(0)) || (side > 0 && fp > S(0))) st.mode = Mode::kFree;
         }
       } else {
         st.mode = side < 0 ? Mode::kContactLeft : Mode::kContactRight;
+        const S dl = side < 0 ? overlap_left<S>(dm, st.rel_pos(y)) : overlap_right<S>(dm, st.rel_pos(y));
+        y(Stepper::kQ) = std::sqrt(std::sqrt(std::fmax(dl, S(0))));
         d.contact_depth = S(0);
       }
       break;
@@ -235,12 +262,14 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
       if (overlap_right<S>(dm, r) > tol && rd > S(0)) return 1;
       return 0;
     case Mode::kContactLeft:
-      return overlap_left<S>(dm, r) < S(0) || (overlap_left<S>(dm, r) == S(0) && rd > S(0)) ? -1 : 0;
-    case Mode::kContactRight:
-      return overlap_right<S>(dm, r) < S(0) || (overlap_right<S>(dm, r) == S(0) && rd < S(0)) ? 1 : 0;
+    case Mode::kContactRight: {
+      const S q = y(Stepper::kQ), ddl = st.overlap_rate(y);
+      const int side = st.mode == Mode::kContactLeft ? -1 : 1;
+      return q < S(0) || (q == S(0) && ddl <= S(0)) ? side : 0;
+    }
     default: {
       S fp, loss;
-      st.force(y, S(0), &fp, &loss);
+      st.force(y, &fp, &loss);
       // Leave once the wall would have to pull (beyond rounding: 1e-9 m/s^2).
       const bool left = st.mode == Mode::kStuckLeft;
       const S pull = (left ? -fp : fp) * m.dev.inv_m;
@@ -249,17 +278,19 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   }
 }
 
-// Sub-stepped step from the current state to the next sample a1.
+// Sub-stepped step from the current state to the next sample a1. The
+// independent variable u is t outside contacts and w inside (see the top).
 template <typename S, int N, typename Dev>
 void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   using Stepper = detail::SubStepper<S, N, Dev>;
   using Vec = typename Stepper::Vec;
+  constexpr int kT = Stepper::kT, kQ = Stepper::kQ;
   const auto& dm = m.dev;
   const S h = m.hs;
+  constexpr S kEps = std::numeric_limits<S>::epsilon();
   // Tolerances that the scalar can honour.
-  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol),
-                           S(64) * std::numeric_limits<S>::epsilon());
+  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * kEps);
   const S event_tol = event_tolerance(m);
   const int cap = m.loop.max_substeps_per_step;
 
@@ -268,30 +299,36 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   y.template head<NX>() = d.z;
   y(NX) = d.s;
   y(NX + 1) = d.sd;
-  y.template tail<4>().setZero();
+  y.template segment<4>(NX + 2).setZero();
+  y(kT) = S(0);
+  y(kQ) = d.q;
   Vec f = st(S(0), y);
-  S t = S(0);
-  S hc = d.substep > S(0) ? std::fmin(d.substep, h) : h;
+  S u = S(0);  // the integrator's variable; only differences matter
+  // Step sizes carried across steps, one per variable.
+  S hc_t = d.substep > S(0) ? std::fmin(d.substep, h) : h;
+  S hc_w = d.substep_w > S(0) ? d.substep_w : dm.w_step0;
   int n = 0;
   bool capped = false;
   ++d.count.careful_steps;
   // Event function of the current mode: crosses zero upwards at the event.
+  // Side 0 in a contact: the end of the sensor step (t = h).
   auto event_value = [&](const Vec& yy, const Vec& ff, int side, S* slope) {
-    (void)ff;
+    if (side == 0) {
+      *slope = ff(kT);
+      return yy(kT) - h;
+    }
     const S r = st.rel_pos(yy), rd = st.rel_vel(yy);
     switch (st.mode) {
       case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
         *slope = side < 0 ? -rd : rd;
         return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - event_tol;
-      case Mode::kContactLeft:  // overlap returns to zero
-        *slope = rd;
-        return -overlap_left<S>(dm, r);
+      case Mode::kContactLeft:  // q returns to zero
       case Mode::kContactRight:
-        *slope = -rd;
-        return -overlap_right<S>(dm, r);
+        *slope = -ff(kQ);
+        return -yy(kQ);
       default: {  // stuck: the holding force changes sign
         S fp, loss;
-        st.force(yy, S(0), &fp, &loss);
+        st.force(yy, &fp, &loss);
         *slope = S(0);
         return st.mode == Mode::kStuckLeft ? -fp : fp;
       }
@@ -299,7 +336,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   };
 
   int immediate = 0;
-  while (t < h) {
+  while (y(kT) < h) {
     // An event already due at the start of the sub-step (the state sits on
     // the far side of a switching surface within rounding): apply it now.
     if (immediate < 4) {
@@ -307,28 +344,36 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
       if (due != 0) {
         ++immediate;
         ++d.count.events;
+        const bool was_regular = st.regular();
         apply_event(m, d, st, y, due);
-        f = st(t, y);
+        if (st.regular() && !was_regular) hc_w = dm.w_step0;
+        f = st(u, y);
         continue;
       }
     }
+    const bool reg = st.regular();
     const bool forced = n >= cap - 1;
-    const S hs = forced ? h - t : std::fmin(hc, h - t);
-    auto r = numeric::dopri5_step<Vec>(st, t, y, f, hs);
+    S hs;
+    if (!reg) hs = std::fmin(hc_t, h - y(kT));
+    else if (forced) hs = (h - y(kT)) / std::fmax(f(kT), kEps);  // to t = h at the current rate
+    else hs = hc_w;
+    auto r = numeric::dopri5_step<Vec>(st, u, y, f, hs);
     const S en = st.error_norm(r.err, y, r.y, rtol);
     ++n;
     if (!forced && !(en <= S(1))) {
       ++d.count.rejected;
-      hc = hs * std::fmax(S(0.1), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2)));
+      (reg ? hc_w : hc_t) = hs * std::fmax(S(0.1), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2)));
       continue;
     }
     if (forced) capped = true;
 
-    // Does an event happen inside this sub-step? Which side first? (Not in a
+    // Does an event happen inside this sub-step? Which first? (Not in a
     // forced sub-step: past the cap, events wait for the next step.)
     S theta = S(2);
     int side = 0;
-    for (int sd = -1; sd <= 1 && !forced; sd += 2) {
+    bool any = false;
+    for (int sd = -1; sd <= 1 && !forced; ++sd) {
+      if (sd == 0 && !reg) continue;           // t = h: only in w
       if (st.mode != Mode::kFree && sd == 1) break;
       S s0, s1;
       const S g0 = event_value(y, f, sd, &s0), g1 = event_value(r.y, r.f, sd, &s1);
@@ -337,68 +382,83 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
       const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
       if (!hit || g0 > S(0)) continue;
       const S th = stuck ? g0 / (g0 - g1) : cub.first_upcrossing();
-      if (th < theta) { theta = th; side = sd; }
+      if (!any || th < theta) {
+        theta = th;
+        side = sd;
+        any = true;
+      }
     }
 
-    if (theta <= S(1)) {
+    if (any && theta <= S(1)) {
       // Place the event: Illinois iterations on the true sub-step, bracket
-      // [0, hs], starting from the cubic's estimate.
+      // [0, hs], starting from the cubic's estimate. The step end (side 0)
+      // is placed to rounding of t.
+      const S tol = side == 0 ? S(4) * kEps * h : event_tol;
       S lo = S(0), hi = hs, glo, ghi, slope;
       glo = event_value(y, f, side, &slope);
       ghi = S(1);
       S tau = theta * hs;
-      auto rr = numeric::dopri5_step<Vec>(st, t, y, f, tau);
+      auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
       int last = 0;
       for (int it = 0; it < 40; ++it) {
         const S g = event_value(rr.y, rr.f, side, &slope);
-        if (std::fabs(g) <= event_tol && g >= S(0)) break;
+        if (std::fabs(g) <= tol && g >= S(0)) break;
         if (g > S(0)) { hi = tau; ghi = g; if (last == 1) glo *= S(0.5); last = 1; }
         else { lo = tau; glo = g; if (last == -1) ghi *= S(0.5); last = -1; }
-        if (hi - lo <= S(4) * std::numeric_limits<S>::epsilon() * (t + hi)) { tau = hi; }
+        if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) { tau = hi; }
         else {
           tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
           if (!(tau > lo && tau < hi)) tau = S(0.5) * (lo + hi);
         }
-        rr = numeric::dopri5_step<Vec>(st, t, y, f, tau);
-        if (tau == hi && hi - lo <= S(4) * std::numeric_limits<S>::epsilon() * (t + hi)) break;
+        rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
+        if (tau == hi && hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) break;
       }
       // Accept up to the event.
-      track_substep(m, d, st.mode, y, rr.y, tau, d.time(m) + static_cast<double>(t + tau));
-      t += tau;
+      track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), d.time(m) + static_cast<double>(rr.y(kT)));
+      u += tau;
       y = rr.y;
       ++d.count.substeps;
-      ++d.count.events;
       if (st.mode != Mode::kFree) ++d.count.contact_substeps;
+      if (side == 0) {  // the step ends inside the contact
+        y(kT) = h;
+        break;
+      }
+      ++d.count.events;
+      const bool was_regular = st.regular();
       apply_event(m, d, st, y, side);
-      f = st(t, y);
+      if (st.regular() && !was_regular) hc_w = dm.w_step0;
+      f = st(u, y);
       continue;
     }
 
     // Plain accepted sub-step.
-    track_substep(m, d, st.mode, y, r.y, hs, d.time(m) + static_cast<double>(t + hs));
-    t += hs;
+    track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), d.time(m) + static_cast<double>(r.y(kT)));
+    u += hs;
     y = r.y;
     f = r.f;
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
-    hc = hs * std::fmin(S(5), std::fmax(S(0.2), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2))));
-    if (t >= h * (S(1) - S(8) * std::numeric_limits<S>::epsilon())) break;
+    (reg ? hc_w : hc_t) =
+        hs * std::fmin(S(5), std::fmax(S(0.2), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2))));
+    if (forced || y(kT) >= h * (S(1) - S(8) * kEps)) break;
   }
   if (capped) ++d.count.cap_hits;
   if (n > d.count.max_substeps_in_step) d.count.max_substeps_in_step = n;
 
   // Write the state back.
   d.mode = st.mode;
-  d.substep = hc;
+  d.substep = hc_t;
+  d.substep_w = hc_w;
   d.z = y.template head<NX>();
   d.s = y(NX);
   d.sd = y(NX + 1);
+  d.q = st.regular() ? y(kQ) : S(0);
   d.ledger.contact += static_cast<double>(y(NX + 2));
   d.ledger.input += static_cast<double>(y(NX + 3));
   d.ledger.damping += static_cast<double>(y(NX + 4));
   d.elastic_energy += static_cast<double>(y(NX + 5));
   S fp, loss;
-  st.force(y, h, &fp, &loss);
+  st.force(y, &fp, &loss);
   d.contact_force = fp;
 }
 
