@@ -86,9 +86,11 @@ struct ModalForm {
   using VecP = Eigen::Matrix<S, P, 1>;
   VecP qq, qv, vv, qa, va;
   S aa = S(0);
+  bool positions_only = false;  // only qq is nonzero (the strain energy)
 
   S eval(const VecX& z, S ag) const {
     const auto q = z.template head<P>().array();
+    if (positions_only) return (q * qq.array() * q).sum();
     const auto v = z.template tail<P>().array();
     return (q * (qq.array() * q + qv.array() * v + qa.array() * ag)).sum() +
            (v * (vv.array() * v + va.array() * ag)).sum() + aa * ag * ag;
@@ -290,6 +292,7 @@ ModalForm<S, P> form_modal(const Eigen::Matrix<double, 2 * P + 1, 2 * P + 1>& q)
     out.va(j) = static_cast<S>(2 * q(P + j, NX));
   }
   out.aa = static_cast<S>(q(NX, NX));
+  out.positions_only = out.qv.isZero() && out.vv.isZero() && out.qa.isZero() && out.va.isZero() && out.aa == S(0);
   return out;
 }
 
