@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "sim_host/scalar.hpp"
 #include "vines/data.hpp"
@@ -67,10 +69,16 @@ class Engine {
 };
 
 // The engine for a scene's story count, device and law, or nullptr if this
-// build does not include that story count (see VINES_STORY_COUNTS).
+// build does not include it (see VINES_STORY_COUNTS, VINES_STRESS_STORY_COUNTS).
 std::unique_ptr<Engine> make_engine(const SceneParams& p, Scalar scalar);
 
-// Story counts compiled into this build, for messages.
-const char* compiled_story_counts();
+// Story counts with an engine for this scalar and device kind.
+std::vector<int> compiled_frames(Scalar scalar, DeviceKind kind);
+
+// The story counts compiled into this build and what each has, for messages.
+std::string compiled_story_counts();
+
+// Why make_engine(p, scalar) gave nullptr, and how to reconfigure.
+std::string missing_engine(const SceneParams& p, Scalar scalar);
 
 }  // namespace vines::host
