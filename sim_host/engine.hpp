@@ -56,6 +56,16 @@ struct RunTotals {
   Counters count;
 };
 
+// What the loop holds after a step, cheap to read every step (no outputs
+// computed): counters, ledger, and the VI NES particle against the walls.
+struct Probe {
+  Counters count;
+  Ledger ledger;
+  double peak_top = 0;  // running peak of the top floor [m]
+  int mode = 0;         // vines::Mode (VI NES)
+  double overlap = 0;   // how far the particle is past the nearer wall now [m] (< 0: still short of it)
+};
+
 class Engine {
  public:
   virtual ~Engine() = default;
@@ -66,6 +76,7 @@ class Engine {
   virtual void step(double a1) = 0;
   virtual Snapshot snapshot() const = 0;
   virtual RunTotals totals() const = 0;
+  virtual Probe probe() const = 0;
 };
 
 // The engine for a scene's story count, device and law, or nullptr if this
