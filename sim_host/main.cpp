@@ -153,6 +153,15 @@ int cmd_run(const std::vector<std::string>& args) {
       std::printf("  loop wall time %.2f ms; results in %s/\n", 1e3 * j["wall_time_s"].get<double>(),
                   opt.out_dir.c_str());
     }
+    // Limits the loop ran into are reported, never silent (even with --quiet).
+    const auto& k = j["counters"];
+    if (k["substep_cap_hits"].get<long long>() > 0)
+      std::fprintf(stderr, "vines run: warning: %lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): "
+                   "contacts in them are not resolved\n",
+                   k["substep_cap_hits"].get<long long>(), scene.params.loop.max_substeps_per_step);
+    if (k["divergences_rolled_back"].get<long long>() + k["bad_samples_held"].get<long long>() > 0)
+      std::fprintf(stderr, "vines run: warning: %lld diverging steps rolled back, %lld non-finite samples held\n",
+                   k["divergences_rolled_back"].get<long long>(), k["bad_samples_held"].get<long long>());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vines run: %s\n", e.what());
