@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "sim_host/scalar.hpp"
 #include "vines/data.hpp"
@@ -54,6 +56,16 @@ struct RunTotals {
   Counters count;
 };
 
+// What the loop holds after a step, cheap to read every step (no outputs
+// computed): counters, ledger, and the VI NES particle against the walls.
+struct Probe {
+  Counters count;
+  Ledger ledger;
+  double peak_top = 0;  // running peak of the top floor [m]
+  int mode = 0;         // vines::Mode (VI NES)
+  double overlap = 0;   // how far the particle is past the nearer wall now [m] (< 0: still short of it)
+};
+
 class Engine {
  public:
   virtual ~Engine() = default;
@@ -64,13 +76,20 @@ class Engine {
   virtual void step(double a1) = 0;
   virtual Snapshot snapshot() const = 0;
   virtual RunTotals totals() const = 0;
+  virtual Probe probe() const = 0;
 };
 
 // The engine for a scene's story count, device and law, or nullptr if this
-// build does not include that story count (see VINES_STORY_COUNTS).
+// build does not include it (see VINES_STORY_COUNTS, VINES_STRESS_STORY_COUNTS).
 std::unique_ptr<Engine> make_engine(const SceneParams& p, Scalar scalar);
 
-// Story counts compiled into this build, for messages.
-const char* compiled_story_counts();
+// Story counts with an engine for this scalar and device kind.
+std::vector<int> compiled_frames(Scalar scalar, DeviceKind kind);
+
+// The story counts compiled into this build and what each has, for messages.
+std::string compiled_story_counts();
+
+// Why make_engine(p, scalar) gave nullptr, and how to reconfigure.
+std::string missing_engine(const SceneParams& p, Scalar scalar);
 
 }  // namespace vines::host

@@ -2,6 +2,7 @@
 // owns a Model and a Data block and copies outputs out in double.
 #pragma once
 
+#include <cmath>
 #include <memory>
 
 #include "sim_host/engine.hpp"
@@ -67,6 +68,21 @@ class EngineImpl final : public Engine {
       s.tmd_v = static_cast<double>(d.z(2 * N + 1));
     }
     return s;
+  }
+
+  Probe probe() const override {
+    const Model<S, N, Dev>& m = *model_;
+    const Data<S, N, Dev>& d = *data_;
+    Probe p;
+    p.count = d.count;
+    p.ledger = d.ledger;
+    p.peak_top = static_cast<double>(d.peak_top);
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      const S r = d.s - d.xf;
+      p.mode = static_cast<int>(d.mode);
+      p.overlap = static_cast<double>(std::fmax(m.dev.wall_left - r, r - m.dev.wall_right));
+    }
+    return p;
   }
 
   RunTotals totals() const override {

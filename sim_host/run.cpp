@@ -43,10 +43,7 @@ struct Trace {
 Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
   std::unique_ptr<Engine> eng = make_engine(p, scene.scalar);
   if (!eng)
-    throw std::runtime_error(scene.path + ": frame.stories: this build has frames of " +
-                             std::string(compiled_story_counts()) +
-                             " stories; reconfigure with -DVINES_STORY_COUNTS=\"...;" +
-                             std::to_string(p.frame.stories) + "\"");
+    throw std::runtime_error(scene.path + ": frame.stories: " + missing_engine(p, scene.scalar));
   const ParamError e = eng->build(p);
   if (!e.ok()) {
     std::string key = e.field;

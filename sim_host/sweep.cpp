@@ -200,7 +200,7 @@ class Cache {
 
   static std::unique_ptr<Engine> build(const Scene& s, const SceneParams& p) {
     std::unique_ptr<Engine> e = make_engine(p, s.scalar);
-    if (!e) fail(s.path, "frame.stories: this build has frames of " + std::string(compiled_story_counts()) + " stories");
+    if (!e) fail(s.path, "frame.stories: " + missing_engine(p, s.scalar));
     const ParamError err = e->build(p);
     if (!err.ok()) fail(s.path, std::string(err.field) + ": " + err.message);
     return e;

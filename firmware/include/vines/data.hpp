@@ -21,15 +21,16 @@ enum class Mode : std::uint8_t {
 
 // Energy ledger [J], accumulated in double whatever the loop's scalar.
 struct Ledger {
+  double initial = 0;     // stored at t = 0 (initial conditions): energy put in too
   double input = 0;       // work of the inertial loads -m a_g on every mass
   double damping = 0;     // dissipated by the frame's (and TMD's) dashpots
   double contact = 0;     // dissipated in contacts (rate term, or impacts)
   double kinetic = 0;     // stored now: kinetic...
   double strain = 0;      // ...frame strain...
   double device = 0;      // ...TMD spring or contact elastic energy
-  double residual = 0;    // input - stored - dissipated, now
+  double residual = 0;    // initial + input - stored - dissipated, now
   double max_abs_residual = 0;
-  double max_input = 0;   // largest of input and stored + dissipated so far
+  double max_input = 0;   // largest of initial + input and stored + dissipated so far
   double relative_residual() const { return max_input > 0 ? max_abs_residual / max_input : 0; }
 };
 

@@ -172,6 +172,15 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
                                  : p.device.mass_ratio * md.nominal_modal.m_eff(0);
   const double floor_mass = md.frame.m(md.floor);
 
+  // Rayleigh damping fitted on two modes, zeta(w) = a0 / (2w) + a1 w / 2, goes
+  // negative on the other modes when a1 < 0 or a0 < 0: they would grow
+  // without bound, so the frame is refused (beyond rounding).
+  for (int j = 0; j < N; ++j)
+    if (p.frame.damping == DampingRule::kRayleigh && md.modal.zeta(j) < -1e-9)
+      return {"frame.rayleigh_zeta",
+              "gives another mode a negative damping ratio (its response would grow without "
+              "bound): zeta2 / zeta1 must lie between w1 / w2 and w2 / w1 of the two modes"};
+
   // Classical damping is what makes the modal blocks exact: check it.
   if constexpr (M::kModal) {
     const Eigen::Matrix<double, N, N> cm = md.modal.phi.transpose() * md.frame.C * md.modal.phi;

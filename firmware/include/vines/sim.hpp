@@ -35,9 +35,9 @@ void close_ledger(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   }
   const double dissipated = l.damping + l.contact;
   const double stored = l.kinetic + l.strain + l.device;
-  l.residual = l.input - stored - dissipated;
+  l.residual = l.initial + l.input - stored - dissipated;
   l.max_abs_residual = std::fmax(l.max_abs_residual, std::fabs(l.residual));
-  l.max_input = std::fmax(l.max_input, std::fmax(l.input, stored + dissipated));
+  l.max_input = std::fmax(l.max_input, std::fmax(l.initial + l.input, stored + dissipated));
 }
 
 // The top floor and the device floor from the state.
@@ -72,7 +72,12 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
   d.peak_top = std::fabs(d.xt);
   d.peak_top_velocity = std::fabs(d.vt);
   d.substep = m.hs;
-  if (m.loop.energy_ledger) detail::close_ledger(m, d);
+  if (m.loop.energy_ledger) {
+    detail::close_ledger(m, d);  // the energy stored by the initial conditions
+    d.ledger.initial = d.ledger.kinetic + d.ledger.strain + d.ledger.device;
+    d.ledger.max_abs_residual = 0;
+    detail::close_ledger(m, d);
+  }
   d.last_strain = static_cast<double>(m.strain.eval(d.z, S(0)));
 }
 

@@ -29,7 +29,12 @@
 namespace vines {
 
 // Below this approach speed [m/s] an instantaneous impact is taken as plastic
-// and the particle rides the wall (no Zeno cascade of ever smaller bounces).
+// and the particle rides the wall (no Zeno cascade of ever smaller bounces);
+// impacts slower than it are not counted. The threshold also rises to the
+// speed whose rebound, against the acceleration that pushes the particle
+// into the wall, would not lift it by the contact counting depth: such
+// bounces are below what the model resolves, and a cascade of them would be
+// resolved one by one (hundreds of thousands of impacts).
 inline constexpr double kStickSpeed = 1e-6;
 
 // Overlaps below this [m] do not start a contact: rounding makes them when the
@@ -214,7 +219,15 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
         const S rd = st.rel_vel(y);
         const S v_app = side < 0 ? -rd : rd;
         if (v_app <= S(0)) return;
-        const bool plastic = dm.eps * v_app < static_cast<S>(kStickSpeed);
+        S push, unused;  // the force that would hold the particle on the wall
+        const Mode before = st.mode;
+        st.mode = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
+        st.force(y, &push, &unused);
+        st.mode = before;
+        // The wall holds the particle with a force towards the box: + on the left.
+        const S a_in = std::fmax(side < 0 ? push : -push, S(0)) / dm.m_star;
+        const S v_stick = std::fmax(static_cast<S>(kStickSpeed), std::sqrt(S(2) * a_in * dm.count_depth));
+        const bool plastic = dm.eps * v_app < v_stick;
         const S e = plastic ? S(0) : dm.eps;
         const S j = contact::restitution_impulse(dm.m, S(1) / m.inv_floor_mass, v_app, e);
         const S jp = side < 0 ? j : -j;  // impulse on the particle
@@ -222,6 +235,9 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
         VecX z = y.template head<NX>();
         m.lti.impulse(z, -jp);  // the floor takes the opposite impulse
         y.template head<NX>() = z;
+        // The impact was placed up to the event tolerance past the wall: put
+        // the particle back on it, so that the next approach is seen again.
+        y(NX) += (side < 0 ? dm.wall_left : dm.wall_right) - st.rel_pos(y);
         y(NX + 2) += S(0.5) * dm.m_star * (S(1) - e * e) * v_app * v_app;
         if (v_app > static_cast<S>(kStickSpeed)) ++d.count.contacts;
         if (plastic) {
@@ -238,10 +254,19 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
       }
       break;
     case Mode::kContactLeft:
-    case Mode::kContactRight:
+    case Mode::kContactRight: {
+      // q reached zero: the contact ends, unless the walls still overlap (q
+      // and the overlap drifted apart): then q goes back on the overlap.
+      const S r = st.rel_pos(y);
+      const S dl = st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
+      if (dl > event_tolerance(m)) {
+        y(Stepper::kQ) = std::sqrt(std::sqrt(dl));
+        break;
+      }
       if (d.contact_depth > m.dev.count_depth) ++d.count.contacts;
       st.mode = Mode::kFree;
       break;
+    }
     default:
       st.mode = Mode::kFree;
       break;
@@ -257,10 +282,14 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   const auto& dm = m.dev;
   const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = event_tolerance(m);
   switch (st.mode) {
-    case Mode::kFree:
-      if (overlap_left<S>(dm, r) > tol && rd < S(0)) return -1;
-      if (overlap_right<S>(dm, r) > tol && rd > S(0)) return 1;
+    case Mode::kFree: {
+      // An impact needs an approach speed the law resolves (a particle just
+      // released from a wall sits on it with a rounding-level speed).
+      const S v_min = Dev::kLaw == ContactLaw::kRestitution ? static_cast<S>(kStickSpeed) : S(0);
+      if (overlap_left<S>(dm, r) > tol && rd < -v_min) return -1;
+      if (overlap_right<S>(dm, r) > tol && rd > v_min) return 1;
       return 0;
+    }
     case Mode::kContactLeft:
     case Mode::kContactRight: {
       const S q = y(Stepper::kQ), ddl = st.overlap_rate(y);
@@ -436,6 +465,17 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     u += hs;
     y = r.y;
     f = r.f;
+    if (reg) {
+      // q^4 and the overlap drift apart over a long (resting) contact: put q
+      // back on the overlap once they differ by more than the tolerance.
+      const S r_now = st.rel_pos(y);
+      const S dl = std::fmax(st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r_now) : overlap_right<S>(dm, r_now), S(0));
+      const S q2 = y(kQ) * y(kQ);
+      if (std::fabs(q2 * q2 - dl) > rtol * dm.pos_scale) {
+        y(kQ) = std::sqrt(std::sqrt(dl));
+        f = st(u, y);
+      }
+    }
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
     (reg ? hc_w : hc_t) =
