@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# `vines bench SCENE --json`: one JSON object for the scene's own settings,
+# measured against data/reference: the El Centro Kuwabara scene must be within
+# 1e-6 of the reference peak with the reference's 18 contacts; a bad option
+# and a missing scene are refused with a message.
+set -euo pipefail
+vines="$1"
+src="$2"
+out=$("$vines" bench "$src/data/scenes/elcentro_vines.toml" --json --min-time 0.05)
+printf '%s\n' "$out" | /usr/bin/python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+for k in ("wall_s_median", "runs", "peak_rel_error", "contacts", "steps", "substeps"):
+    assert k in j, "missing key " + k
+assert j["runs"] >= 3, j["runs"]
+assert 0 < j["wall_s_median"] < 1.0, j["wall_s_median"]
+assert j["peak_rel_error"] is not None and j["peak_rel_error"] < 1e-6, j["peak_rel_error"]
+assert j["contacts"] == 18, j["contacts"]
+print("bench_cli: peak error %.2e, %d contacts, %.3f ms" % (j["peak_rel_error"], j["contacts"], 1e3 * j["wall_s_median"]))
+'
+if "$vines" bench "$src/data/scenes/elcentro_vines.toml" --rates fifty 2>/tmp/bench_cli_err.txt; then
+  echo "bench_cli: --rates fifty was accepted" >&2; exit 1
+fi
+grep -q -- "--rates" /tmp/bench_cli_err.txt
+if "$vines" bench /nonexistent.toml --json 2>/tmp/bench_cli_err.txt; then
+  echo "bench_cli: a missing scene was accepted" >&2; exit 1
+fi
+grep -q "nonexistent.toml" /tmp/bench_cli_err.txt
+echo "bench_cli: ok"
