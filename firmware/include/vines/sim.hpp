@@ -104,10 +104,11 @@ bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& 
   return false;
 }
 
-// Commits an exact step to z1 (particle at s1, s1'), with its step integrals.
+// Commits an exact step to z1 (particle at s1, s1'; device floor at xf1,
+// vf1), with its step integrals.
 template <typename S, int N, typename Dev>
 void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S a0,
-                  S a1, S s1, S sd1) {
+                  S a1, S s1, S sd1, S xf1, S vf1) {
   const S xt1 = m.top_x(z1), vt1 = m.top_v(z1);
   d.elastic_energy += static_cast<double>(m.strain_step.eval(d.z, a0, a1));
   if (m.loop.energy_ledger) {
@@ -124,8 +125,8 @@ void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename 
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     d.s = s1;
     d.sd = sd1;
-    d.xf = m.dev_x(z1);
-    d.vf = m.dev_v(z1);
+    d.xf = xf1;
+    d.vf = vf1;
   }
 }
 
@@ -133,12 +134,11 @@ void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename 
 // relative position may reach a wall (cubic through both ends of the free
 // step, with a margin for what a cubic misses).
 template <typename S, int N, typename Dev>
-bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S s1,
-               S sd1) {
+bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1, S xf1, S vf1) {
   const auto& dm = m.dev;
   const S h = m.hs;
   const S r0 = d.s - d.xf, rd0 = d.sd - d.vf;
-  const S r1 = s1 - m.dev_x(z1), rd1 = sd1 - m.dev_v(z1);
+  const S r1 = s1 - xf1, rd1 = sd1 - vf1;
   // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
   // bounded by its end values plus what the cubic allows between them.
   const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
@@ -170,20 +170,22 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   // 1. Exact step into temporaries.
   bool careful = false;
   VecX z1 = d.z;
-  S s1 = S(0), sd1 = S(0);
+  S s1 = S(0), sd1 = S(0), xf1 = S(0), vf1 = S(0);  // particle and device floor (VI NES)
   if constexpr (Dev::kKind == DeviceKind::kVines) careful = d.mode != Mode::kFree;
   if (!careful) {
     m.lti.step(z1, a0, a1);
     if constexpr (Dev::kKind == DeviceKind::kVines) {
       free_flight(m, d.s, d.sd, a0, a1, &s1, &sd1);
-      careful = detail::may_touch(m, d, z1, s1, sd1);
+      xf1 = m.dev_x(z1);
+      vf1 = m.dev_v(z1);
+      careful = detail::may_touch(m, d, s1, sd1, xf1, vf1);
     }
   }
 
   if (!careful) {
     // 2a. Commit the exact step, unless it diverged.
-    if (detail::diverged(m, z1, m.dev_x(z1), s1, sd1)) ++d.count.divergences;
-    else detail::commit_exact(m, d, z1, a0, a1, s1, sd1);
+    if (detail::diverged(m, z1, xf1, s1, sd1)) ++d.count.divergences;
+    else detail::commit_exact(m, d, z1, a0, a1, s1, sd1, xf1, vf1);
   } else if constexpr (Dev::kKind == DeviceKind::kVines) {
     // 2b. Sub-stepped step through (possible) contacts; rolled back whole if
     // it diverged (rare steps: the copy is affordable here).
