@@ -39,6 +39,30 @@ RunTotals run_once(Engine& eng, const std::vector<double>& a) {
   return eng.totals();
 }
 
+// Runs `run` (which returns its wall time) until the line has been timed for
+// min_time_s and min_runs (at most max_runs), then sets the line's runs,
+// median and minimum.
+template <typename Run>
+void time_line(const BenchOptions& opt, std::size_t max_runs, Run run, BenchLine* l) {
+  std::vector<double> walls;
+  double total = 0;
+  while ((total < opt.min_time_s || static_cast<int>(walls.size()) < opt.min_runs) && walls.size() < max_runs) {
+    walls.push_back(run());
+    total += walls.back();
+  }
+  std::sort(walls.begin(), walls.end());
+  l->runs = static_cast<int>(walls.size());
+  l->wall_median_s = walls[walls.size() / 2];
+  l->wall_min_s = walls.front();
+}
+
+// A line's errors against the truth (NaN where it is not known).
+void set_errors(const Truth& truth, BenchLine* l) {
+  l->peak_rel_error = truth.known ? rel(l->peak_top, truth.peak_top) : kNaN;
+  l->elastic_energy_rel_error = truth.known ? rel(l->elastic_energy, truth.elastic_energy) : kNaN;
+  l->x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l->x_r - truth.x_r) : kNaN;
+}
+
 // One firmware line: the scene at one scalar, rate and tolerance.
 BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, const Truth& truth,
                         const BenchOptions& opt) {
@@ -63,19 +87,12 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
 
   // Timed runs: median wall time of whole runs (init + every step).
-  std::vector<double> walls;
-  double total = 0;
   RunTotals t;
-  while ((total < opt.min_time_s || static_cast<int>(walls.size()) < opt.min_runs) && walls.size() < 10000) {
+  time_line(opt, 10000, [&] {
     const auto t0 = std::chrono::steady_clock::now();
     t = run_once(*eng, ex.samples);
-    walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    total += walls.back();
-  }
-  std::sort(walls.begin(), walls.end());
-  l.runs = static_cast<int>(walls.size());
-  l.wall_median_s = walls[walls.size() / 2];
-  l.wall_min_s = walls.front();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }, &l);
   l.steps = t.count.steps;
   l.substeps = t.count.substeps;
   l.rejected = t.count.rejected;
@@ -89,9 +106,7 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
     const RunTotals b = run_once(*built_engine(scene, pb, scalar), ex.samples);
     l.x_r = (b.peak_top - t.peak_top) / b.peak_top;
   }
-  l.peak_rel_error = truth.known ? rel(l.peak_top, truth.peak_top) : kNaN;
-  l.elastic_energy_rel_error = truth.known ? rel(l.elastic_energy, truth.elastic_energy) : kNaN;
-  l.x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l.x_r - truth.x_r) : kNaN;
+  set_errors(truth, &l);
   return l;
 }
 
@@ -110,27 +125,18 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
   l.rtol = rtol;
   reference::Options o;
   o.rtol = rtol;
-  std::vector<double> walls;
-  double total = 0;
   reference::Result r;
-  while ((total < opt.min_time_s || static_cast<int>(walls.size()) < opt.min_runs) && walls.size() < 1000) {
+  time_line(opt, 1000, [&] {
     r = reference::integrate(scene.params, ex.samples, ex.rate_hz, method, o);
-    walls.push_back(r.wall_s);
-    total += r.wall_s;
-  }
-  std::sort(walls.begin(), walls.end());
-  l.runs = static_cast<int>(walls.size());
-  l.wall_median_s = walls[walls.size() / 2];
-  l.wall_min_s = walls.front();
+    return r.wall_s;
+  }, &l);
   l.steps = r.steps;
   l.rejected = r.rejected;
   l.peak_top = r.peak_top;
   l.elastic_energy = r.elastic_energy;
   l.contacts = r.contacts;
   l.x_r = truth.has_x_r ? (truth.bare_peak_top - r.peak_top) / truth.bare_peak_top : kNaN;
-  l.peak_rel_error = truth.known ? rel(l.peak_top, truth.peak_top) : kNaN;
-  l.elastic_energy_rel_error = truth.known ? rel(l.elastic_energy, truth.elastic_energy) : kNaN;
-  l.x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l.x_r - truth.x_r) : kNaN;
+  set_errors(truth, &l);
   return l;
 }
 

@@ -7,28 +7,13 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "sim_host/names.hpp"
+
 namespace vines::host {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-const char* device_name(DeviceKind k) {
-  switch (k) {
-    case DeviceKind::kTmd: return "tmd";
-    case DeviceKind::kVines: return "vines";
-    default: return "none";
-  }
-}
-
-const char* law_name(ContactLaw l) {
-  switch (l) {
-    case ContactLaw::kHertz: return "hertz";
-    case ContactLaw::kTsuji: return "tsuji";
-    case ContactLaw::kKuwabara: return "kuwabara";
-    default: return "restitution";
-  }
-}
 
 std::vector<double> head(const FloorArray& a, int n) { return {a.begin(), a.begin() + n}; }
 

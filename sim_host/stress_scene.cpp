@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "sim_host/engine.hpp"
+#include "sim_host/names.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/stress.hpp"
 
@@ -41,15 +42,6 @@ constexpr RecordFile kRecordFiles[] = {
 
 constexpr ContactLaw kLaws[] = {ContactLaw::kHertz, ContactLaw::kTsuji, ContactLaw::kKuwabara,
                                 ContactLaw::kRestitution};
-
-const char* law_name(ContactLaw l) {
-  switch (l) {
-    case ContactLaw::kHertz: return "hertz";
-    case ContactLaw::kTsuji: return "tsuji";
-    case ContactLaw::kKuwabara: return "kuwabara";
-    default: return "restitution";
-  }
-}
 
 const char* damping_name(DampingRule d) {
   switch (d) {
