@@ -52,7 +52,7 @@ class EngineImpl final : public Engine {
       s.acc[i] = static_cast<double>(acc(i));
       s.drift[i] = s.x[i] - (i ? s.x[i - 1] : 0.0);
     }
-    s.elastic_energy = d.elastic_energy;
+    s.elastic_energy = elastic_energy(m, d);
     if constexpr (Dev::kKind == DeviceKind::kVines) {
       const auto& dm = m.dev;
       s.particle_x = static_cast<double>(dm.y0 + d.s);
@@ -96,7 +96,7 @@ class EngineImpl final : public Engine {
     r.peak_x[N - 1] = r.peak_x[N - 1] > r.peak_top ? r.peak_x[N - 1] : r.peak_top;
     r.t_peak_top = d.t_peak_top;
     r.peak_top_velocity = static_cast<double>(d.peak_top_velocity);
-    r.elastic_energy = d.elastic_energy;
+    r.elastic_energy = elastic_energy(*model_, d);
     r.strain_increments = d.strain_increments;
     r.max_overlap = static_cast<double>(d.max_overlap);
     r.ledger = d.ledger;

@@ -76,7 +76,11 @@ struct Data {
   S peak_top = S(0);
   double t_peak_top = 0;
   S peak_top_velocity = S(0);  // largest |v| of the top floor at the samples
-  double elastic_energy = 0;  // E_e = integral of (1/2) x^T K x dt [J s]
+  // E_e = integral of (1/2) x^T K x dt [J s] is ee_sum, less V(z) while a run
+  // of exact steps is open (ee_open; see lyapunov_split): read it with
+  // elastic_energy(m, d).
+  double ee_sum = 0;
+  bool ee_open = false;
   double strain_increments = 0;  // sum of positive increments of the strain energy [J] (floor_peaks)
   double last_strain = 0;
   Ledger ledger;

@@ -13,7 +13,10 @@
 // computed once in double, then stored in the loop's scalar S.
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 #include "vines/numeric/expm.hpp"
 
@@ -60,6 +63,53 @@ struct ModalLti {
   // Velocity jump of an impulse j of the device force.
   void impulse(VecX& z, S j) const { z.template tail<P>() += bfv * j; }
 };
+
+// What the loop reads off every exact step, taken in the same pass over the
+// modes as the step itself: the top floor and the device floor after it, a
+// cheap bound on every floor (sum of |q_j| max_i |phi_ij|), the sum of the
+// modal velocities (non-finite if any is), and a linear form of the state
+// before the step in (a0, a1) (the E_e step integral, see build_model).
+template <typename S>
+struct StepRead {
+  S xt, vt, xf, vf, bound, vsum, lin;
+};
+
+template <typename S, int P>
+struct ModalRows {
+  using VecP = Eigen::Matrix<S, P, 1>;
+  VecP top = VecP::Zero(), dev = VecP::Zero(), bound = VecP::Zero();  // top floor, device floor, floor bound
+  // lin = sum q (lq0 a0 + lq1 a1) + v (lv0 a0 + lv1 a1)
+  VecP lq0 = VecP::Zero(), lq1 = VecP::Zero(), lv0 = VecP::Zero(), lv1 = VecP::Zero();
+  S l00 = S(0), l01 = S(0), l11 = S(0);  //     + a0 (l00 a0 + l01 a1) + l11 a1^2
+  bool dev_is_top = true;       // the device floor is the top floor (xf = xt)
+};
+
+// Exact step of z0 to z1 with its readouts (WithDev: a device floor is read).
+template <bool WithDev, typename S, int P>
+StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw, const Eigen::Matrix<S, 2 * P, 1>& z0,
+                      Eigen::Matrix<S, 2 * P, 1>& z1, S a0, S a1) {
+  using Arr = Eigen::Array<S, P, 1>;
+  const auto q = z0.template head<P>().array();
+  const auto v = z0.template tail<P>().array();
+  StepRead<S> r;
+  r.lin = (q * (rw.lq0.array() * a0 + rw.lq1.array() * a1) + v * (rw.lv0.array() * a0 + rw.lv1.array() * a1)).sum() +
+          a0 * (rw.l00 * a0 + rw.l01 * a1) + rw.l11 * a1 * a1;
+  const Arr q1 = l.p11.array() * q + l.p12.array() * v + l.gx0.array() * a0 + l.gx1.array() * a1;
+  const Arr v1 = l.p21.array() * q + l.p22.array() * v + l.gv0.array() * a0 + l.gv1.array() * a1;
+  r.xt = (rw.top.array() * q1).sum();
+  r.vt = (rw.top.array() * v1).sum();
+  r.xf = r.xt;
+  r.vf = r.vt;
+  if (WithDev && !rw.dev_is_top) {
+    r.xf = (rw.dev.array() * q1).sum();
+    r.vf = (rw.dev.array() * v1).sum();
+  }
+  r.bound = (rw.bound.array() * q1.abs()).sum();
+  r.vsum = v1.sum();
+  z1.template head<P>() = q1.matrix();
+  z1.template tail<P>() = v1.matrix();
+  return r;
+}
 
 // Integral over one step of a quadratic form in [z; a_g], as a form in
 // (q, q', a0, a1): cross terms already doubled.
@@ -294,6 +344,49 @@ ModalForm<S, P> form_modal(const Eigen::Matrix<double, 2 * P + 1, 2 * P + 1>& q)
   out.aa = static_cast<S>(q(NX, NX));
   out.positions_only = out.qv.isZero() && out.vv.isZero() && out.qa.isZero() && out.va.isZero() && out.aa == S(0);
   return out;
+}
+
+// E_e by a Lyapunov identity. With X_j solving A_j^T X_j + X_j A_j = -Q_j
+// for each mode and V(z) = z^T X z,
+//   integral over a step of z^T Q z = V(z0) - V(z1) + integral of 2 a_g b^T X z,
+// so over a run of exact steps the boundary terms telescope (the loop adds V
+// where a run starts and takes it off where it ends) and a step costs only
+// the last integral, a linear form of z0 in (a0, a1): rows->lq0.. l11.
+// Needs every mode damped (zeta >= 1e-4: X grows like 1 / zeta) and Q a
+// form in z alone; returns false, leaving rows and v alone, otherwise.
+template <typename S, int P>
+bool lyapunov_split(const LtiSpec<2 * P>& spec, const Eigen::Matrix<double, 2 * P + 1, 2 * P + 1>& q, double h,
+                    ModalRows<S, P>* rows, ModalForm<S, P>* v) {
+  constexpr int NX = 2 * P;
+  if (!q.col(NX).isZero()) return false;
+  Eigen::Matrix<double, NX + 1, NX + 1> x = Eigen::Matrix<double, NX + 1, NX + 1>::Zero(), qlin = x;
+  for (int j = 0; j < P; ++j) {
+    const Eigen::Matrix2d a = detail::mode_block<P>(spec.a, j), qj = detail::mode_block<P>(q, j);
+    if (a.isZero() && qj.isZero()) continue;  // a padding mode (see Layout)
+    const double det = a.determinant(), tr = a.trace();
+    if (!(det > 0.0) || !(-tr >= 2e-4 * std::sqrt(det))) return false;
+    // The three equations of the symmetric 2x2 Lyapunov equation.
+    Eigen::Matrix3d mat;
+    mat << 2 * a(0, 0), 2 * a(1, 0), 0.0, a(0, 1), a(0, 0) + a(1, 1), a(1, 0), 0.0, 2 * a(0, 1), 2 * a(1, 1);
+    const Eigen::Vector3d xs = mat.partialPivLu().solve(Eigen::Vector3d(-qj(0, 0), -qj(0, 1), -qj(1, 1)));
+    x(j, j) = xs(0);
+    x(j, P + j) = x(P + j, j) = xs(1);
+    x(P + j, P + j) = xs(2);
+    const Eigen::Vector2d c = Eigen::Matrix2d(Eigen::Matrix2d{{xs(0), xs(1)}, {xs(1), xs(2)}}) *
+                              Eigen::Vector2d(spec.bg(j), spec.bg(P + j));
+    qlin(j, NX) = qlin(NX, j) = c(0);
+    qlin(P + j, NX) = qlin(NX, P + j) = c(1);
+  }
+  const ModalQuad<S, P> lin = quad_integral_modal<S, P>(spec, qlin, h);
+  rows->lq0 = lin.q0;
+  rows->lq1 = lin.q1;
+  rows->lv0 = lin.v0;
+  rows->lv1 = lin.v1;
+  rows->l00 = lin.c00;
+  rows->l01 = lin.c01;
+  rows->l11 = lin.c11;
+  *v = form_modal<S, P>(x);
+  return true;
 }
 
 template <typename S, int NX>

@@ -19,10 +19,19 @@
 
 namespace vines {
 
+// Modal coordinates are padded with inert modes (all coefficients zero) to a
+// multiple of VINES_MODAL_LANES, the target's SIMD width in scalars: a step
+// is then whole vector operations. 1 (no padding) unless the build sets it.
+#ifndef VINES_MODAL_LANES
+#define VINES_MODAL_LANES 1
+#endif
+
 template <typename Dev, int N>
 struct Layout {
   static constexpr bool kModal = true;
-  static constexpr int kNx = 2 * N, kP = N;  // kP: position coordinates
+  static constexpr int kLanes = VINES_MODAL_LANES;
+  static constexpr int kP = (N + kLanes - 1) / kLanes * kLanes;  // position coordinates
+  static constexpr int kNx = 2 * kP;
 };
 template <int N>
 struct Layout<TmdDevice, N> {
@@ -57,6 +66,9 @@ struct DeviceModel<S, VinesDevice<L>> {
   // contacts, q = d^{1/4} of that position, and a first step in w (q moves
   // by ~2 % of its scale).
   S pos_scale, vel_scale, modal_scale, q_scale, w_step0;
+  // Exact free flight over a sensor step under -a_g linear from a0 to a1:
+  // s1 = s + h s' - ff_a0 a0 - ff_a1 a1, s1' = s' - ff_v (a0 + a1).
+  S ff_a0, ff_a1, ff_v;
   // Contacts shallower than this are not counted: the scene's depth, but no
   // less than what the scalar resolves across the box (rounding fakes them).
   S count_depth;
@@ -95,6 +107,12 @@ struct Model {
   // rows of the top floor and the device floor, contiguous.
   Eigen::Matrix<S, N, kP> pos_map;
   VecP top_row, floor_row, bound_row;
+  // Modal form: the same rows, and the E_e linear form, for the fused exact
+  // step (step_read); E_e by the Lyapunov split when every mode is damped,
+  // ee_boundary being its V(z) (see lyapunov_split).
+  ModalRows<S, kP> rows;
+  bool ee_lyapunov = false;
+  ModalForm<S, kP> ee_boundary;
   // Absolute floor acceleration: -(M^-1 K) x - (M^-1 C) v + (force on floor f) / m_f.
   Eigen::Matrix<S, N, N> minv_k, minv_c;
   S inv_floor_mass = S(0);
@@ -233,19 +251,25 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     const Modal<N>& mo = md.modal;
     for (int j = 0; j < N; ++j) {
       const double w = mo.omega(j);
-      spec.a(j, N + j) = 1.0;
-      spec.a(N + j, j) = -w * w;
-      spec.a(N + j, N + j) = -2.0 * mo.zeta(j) * w;
-      spec.bg(N + j) = -mo.gamma(j);
-      spec.bf(N + j) = mo.phi(md.floor, j);
-      px.col(j) = mo.phi.col(j);
-      pv.col(N + j) = mo.phi.col(j);
+      spec.a(j, P + j) = 1.0;
+      spec.a(P + j, j) = -w * w;
+      spec.a(P + j, P + j) = -2.0 * mo.zeta(j) * w;
+      spec.bg(P + j) = -mo.gamma(j);
+      spec.bf(P + j) = mo.phi(md.floor, j);
+      px.col(j).template head<N>() = mo.phi.col(j);
+      pv.col(P + j).template head<N>() = mo.phi.col(j);
     }
-    md.pos_map = mo.phi.template cast<S>();
+    // Padding modes j >= N: no coupling, no input, zero rows: they stay 0.
+    md.pos_map.setZero();
+    md.pos_map.template leftCols<N>() = mo.phi.template cast<S>();
   }
   md.top_row = md.pos_map.row(N - 1).transpose();
   md.floor_row = md.pos_map.row(md.floor).transpose();
   md.bound_row = md.pos_map.cwiseAbs().colwise().maxCoeff().transpose();
+  md.rows.top = md.top_row;
+  md.rows.dev = md.floor_row;
+  md.rows.bound = md.bound_row;
+  md.rows.dev_is_top = md.floor == N - 1;
   if constexpr (M::kModal) md.lti = discretise_modal<S, P>(spec, md.h);
   else md.lti = discretise_dense<S, NX>(spec, md.h);
 
@@ -275,6 +299,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   md.damping_power = form(q_damp);
   md.input_power = form(q_in);
   md.strain_step = integral(q_strain);
+  if constexpr (M::kModal) md.ee_lyapunov = lyapunov_split<S, P>(spec, q_strain, md.h, &md.rows, &md.ee_boundary);
   if (p.loop.energy_ledger) {
     md.input_step = integral(q_in);
     md.damping_step = integral(q_damp);
@@ -316,6 +341,9 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.vel_scale = static_cast<S>(v_scale);
     dm.modal_scale = static_cast<S>(std::sqrt(md.frame.m.sum()));
     dm.q_scale = static_cast<S>(std::pow(static_cast<double>(dm.pos_scale), 0.25));
+    dm.ff_a0 = static_cast<S>(md.h * md.h / 3.0);
+    dm.ff_a1 = static_cast<S>(md.h * md.h / 6.0);
+    dm.ff_v = static_cast<S>(md.h / 2.0);
     dm.w_step0 = static_cast<S>(0.02 * std::pow(static_cast<double>(dm.pos_scale), 0.25) / v_scale);
     const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
     dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));

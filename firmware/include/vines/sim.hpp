@@ -1,9 +1,11 @@
 // The fixed-step loop: one step per sensor sample, the ground acceleration
 // linear between two samples. Pipeline of a step:
-//   1. exact step of the linear part and the free particle into temporaries;
+//   1. exact step of the linear part and the free particle into temporaries,
+//      with what the loop reads off it taken in the same pass (modal form);
 //      a VI NES checks whether its particle may touch a wall during the step;
 //   2. if not: the exact step is committed with its exact step integrals
 //      (E_e; the energy ledger and per-floor peaks only when asked for);
+//      E_e by the Lyapunov split, a linear form per step;
 //      if so: adaptive Dormand-Prince sub-steps through the step, contact
 //      starts and ends located to rounding, capped per step (cap hits are
 //      counted);
@@ -15,6 +17,7 @@
 
 #include "vines/data.hpp"
 #include "vines/model.hpp"
+#include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
 #include "vines/substep.hpp"
 
@@ -86,13 +89,14 @@ namespace detail {
 // Divergence check (MuJoCo-style warning) on a state z (with the particle at
 // s, s'): anything non-finite, a floor or the TMD beyond the model's limit,
 // or a particle beyond a wall by more than its radius. The floors are first
-// bounded cheaply (sum of |q_j| max_i |phi_ij|); only a bound beyond the
-// limit costs the floors themselves.
+// bounded cheaply (bound: sum of |q_j| max_i |phi_ij|; vsum: the sum of the
+// velocity coordinates, non-finite if any is); only a bound beyond the limit
+// costs the floors themselves.
 template <typename S, int N, typename Dev>
-bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
+bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound, S vsum, S xf, S s,
+              S sd) {
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
-  const S bound = m.floor_bound(z);
-  if (!std::isfinite(bound) || !std::isfinite(z.template tail<Model<S, N, Dev>::kP>().sum())) return true;
+  if (!std::isfinite(bound + vsum)) return true;  // bound >= 0: an infinity stays one
   if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     if (!(std::fabs(z(N)) <= limit)) return true;
@@ -103,14 +107,58 @@ bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& 
   }
   return false;
 }
-
-// Commits an exact step to z1 (particle at s1, s1'; device floor at xf1,
-// vf1), with its step integrals.
 template <typename S, int N, typename Dev>
-void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S a0,
-                  S a1, S s1, S sd1, S xf1, S vf1) {
-  const S xt1 = m.top_x(z1), vt1 = m.top_v(z1);
-  d.elastic_energy += static_cast<double>(m.strain_step.eval(d.z, a0, a1));
+bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
+  return diverged(m, z, m.floor_bound(z), z.template tail<Model<S, N, Dev>::kP>().sum(), xf, s, sd);
+}
+
+// The exact step of the linear part from d.z to z1 with its readouts: the
+// modal form fuses them into the step (step_read); the dense form (TMD)
+// reads them off z1.
+template <typename S, int N, typename Dev>
+StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, typename Model<S, N, Dev>::VecX& z1,
+                        S a0, S a1) {
+  if constexpr (Model<S, N, Dev>::kModal) {
+    return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, d.z, z1, a0, a1);
+  } else {
+    z1 = d.z;
+    m.lti.step(z1, a0, a1);
+    const S xt = m.top_x(z1), vt = m.top_v(z1);
+    return {xt, vt, m.dev_x(z1), m.dev_v(z1), m.floor_bound(z1),
+            z1.template tail<Model<S, N, Dev>::kP>().sum(), S(0)};
+  }
+}
+
+// E_e over the exact step from d.z (r: its readouts). With the Lyapunov
+// split, a run of exact steps opens with V(z) added (E_e is then
+// ee_sum - V(z_now)) and each step adds its linear form.
+template <typename S, int N, typename Dev>
+void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0, S a1) {
+  if (m.ee_lyapunov) {
+    if (!d.ee_open) {
+      d.ee_sum += static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
+      d.ee_open = true;
+    }
+    d.ee_sum += static_cast<double>(r.lin);
+  } else {
+    d.ee_sum += static_cast<double>(m.strain_step.eval(d.z, a0, a1));
+  }
+}
+
+// Closes a run of exact steps (before anything else changes the state).
+template <typename S, int N, typename Dev>
+void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
+  if (!d.ee_open) return;
+  d.ee_sum -= static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
+  d.ee_open = false;
+}
+
+// Commits an exact step to z1 (readouts r; particle at s1, s1'), with its
+// step integrals.
+template <typename S, int N, typename Dev>
+void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1,
+                  const StepRead<S>& r, S a0, S a1, S s1, S sd1) {
+  add_elastic_step(m, d, r, a0, a1);
   if (m.loop.energy_ledger) {
     d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
     d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
@@ -118,15 +166,15 @@ void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename 
   }
   if (m.loop.floor_peaks)
     update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.hs, d.peak_x, d.peak_drift);
-  update_top_peak(m, d, d.z, z1, a0, a1, d.xt, d.vt, xt1, vt1);
+  update_top_peak(m, d, d.z, z1, a0, a1, d.xt, d.vt, r.xt, r.vt);
   d.z = z1;
-  d.xt = xt1;
-  d.vt = vt1;
+  d.xt = r.xt;
+  d.vt = r.vt;
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     d.s = s1;
     d.sd = sd1;
-    d.xf = xf1;
-    d.vf = vf1;
+    d.xf = r.xf;
+    d.vf = r.vf;
   }
 }
 
@@ -142,8 +190,9 @@ bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1,
   // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
   // bounded by its end values plus what the cubic allows between them.
   const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
-  const S reach = h * (std::fmax(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + tiny;
-  const S lo = std::fmin(r0, r1) - reach, hi = std::fmax(r0, r1) + reach;
+  using numeric::abs_of;
+  const S reach = h * (numeric::max_of(abs_of(rd0), abs_of(rd1)) + abs_of(rd1 - rd0)) + tiny;
+  const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
   if (lo > dm.wall_left && hi < dm.wall_right) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + tiny;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
@@ -169,34 +218,36 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
 
   // 1. Exact step into temporaries.
   bool careful = false;
-  VecX z1 = d.z;
-  S s1 = S(0), sd1 = S(0), xf1 = S(0), vf1 = S(0);  // particle and device floor (VI NES)
   if constexpr (Dev::kKind == DeviceKind::kVines) careful = d.mode != Mode::kFree;
   if (!careful) {
-    m.lti.step(z1, a0, a1);
+    VecX z1;
+    const StepRead<S> r = detail::linear_step(m, d, z1, a0, a1);
+    S s1 = S(0), sd1 = S(0);  // the particle (VI NES)
     if constexpr (Dev::kKind == DeviceKind::kVines) {
       free_flight(m, d.s, d.sd, a0, a1, &s1, &sd1);
-      xf1 = m.dev_x(z1);
-      vf1 = m.dev_v(z1);
-      careful = detail::may_touch(m, d, s1, sd1, xf1, vf1);
+      careful = detail::may_touch(m, d, s1, sd1, r.xf, r.vf);
+    }
+    // 2a. Commit the exact step, unless it diverged.
+    if (!careful) {
+      if (detail::diverged(m, z1, r.bound, r.vsum, r.xf, s1, sd1)) ++d.count.divergences;
+      else detail::commit_exact(m, d, z1, r, a0, a1, s1, sd1);
     }
   }
 
-  if (!careful) {
-    // 2a. Commit the exact step, unless it diverged.
-    if (detail::diverged(m, z1, xf1, s1, sd1)) ++d.count.divergences;
-    else detail::commit_exact(m, d, z1, a0, a1, s1, sd1, xf1, vf1);
-  } else if constexpr (Dev::kKind == DeviceKind::kVines) {
-    // 2b. Sub-stepped step through (possible) contacts; rolled back whole if
-    // it diverged (rare steps: the copy is affordable here).
-    const Data<S, N, Dev> before = d;
-    substep_through(m, d, a0, a1);
-    detail::refresh_floors(m, d);
-    if (detail::diverged(m, d.z, d.xf, d.s, d.sd)) {
-      const Counters count = d.count;
-      d = before;
-      d.count = count;
-      ++d.count.divergences;
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    if (careful) {
+      // 2b. Sub-stepped step through (possible) contacts; rolled back whole
+      // if it diverged (rare steps: the copy is affordable here).
+      detail::close_elastic_run(m, d);
+      const Data<S, N, Dev> before = d;
+      substep_through(m, d, a0, a1);
+      detail::refresh_floors(m, d);
+      if (detail::diverged(m, d.z, d.xf, d.s, d.sd)) {
+        const Counters count = d.count;
+        d = before;
+        d.count = count;
+        ++d.count.divergences;
+      }
     }
   }
 
@@ -211,6 +262,12 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
     d.last_strain = strain_now;
   }
   if (m.loop.energy_ledger) detail::close_ledger(m, d);
+}
+
+// E_e so far [J s].
+template <typename S, int N, typename Dev>
+double elastic_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
+  return d.ee_open ? d.ee_sum - static_cast<double>(m.ee_boundary.eval(d.z, S(0))) : d.ee_sum;
 }
 
 // Floor displacements and velocities now (outputs only).

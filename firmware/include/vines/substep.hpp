@@ -24,6 +24,7 @@
 #include "vines/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
+#include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
 
 namespace vines {
@@ -67,9 +68,9 @@ S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
 // from a0 to a1): from (s, s') to (*s1, *sd1).
 template <typename S, int N, typename Dev>
 void free_flight(const Model<S, N, Dev>& m, S s, S sd, S a0, S a1, S* s1, S* sd1) {
-  const S h = m.hs, al = (a1 - a0) / h;
-  *s1 = s + sd * h - a0 * h * h / S(2) - al * h * h * h / S(6);
-  *sd1 = sd - a0 * h - al * h * h / S(2);
+  const auto& dm = m.dev;
+  *s1 = s + sd * m.hs - a0 * dm.ff_a0 - a1 * dm.ff_a1;
+  *sd1 = sd - (a0 + a1) * dm.ff_v;
 }
 
 // Work of the particle's inertial load over that step: -m integral a v dt,
@@ -161,22 +162,29 @@ struct SubStepper {
     return dy;
   }
 
-  // Error of a sub-step relative to the scales of a contact (energies excluded).
-  S error_norm(const Vec& e, const Vec& y0, const Vec& y1, S rtol) const {
+  // Error scales of the frame and the particle: a typical contact position
+  // and speed (the modal coordinates weighted by the total mass).
+  static Eigen::Array<S, NX + 2, 1> error_scale(const Model<S, N, Dev>& m) {
     const auto& dm = m.dev;
-    S worst = S(0);
-    for (int i = 0; i < NX + 2; ++i) {
-      const bool modal = i < NX, vel = modal ? i >= NX / 2 : i == NX + 1;
-      S scale = vel ? dm.vel_scale : dm.pos_scale;
-      if (modal) scale *= dm.modal_scale;
-      const S mag = std::fmax(std::fabs(y0(i)), std::fabs(y1(i)));
-      const S r = std::fabs(e(i)) / (rtol * (scale + mag));
-      if (r > worst) worst = r;
-    }
-    // Time, and q in a contact.
-    const S rt = std::fabs(e(kT)) / (rtol * m.hs);
-    const S rq = regular() ? std::fabs(e(kQ)) / (rtol * dm.q_scale) : S(0);
-    return std::fmax(worst, std::fmax(rt, rq));
+    Eigen::Array<S, NX + 2, 1> sc;
+    sc.template head<NX / 2>().setConstant(dm.pos_scale * dm.modal_scale);
+    sc.template segment<NX / 2>(NX / 2).setConstant(dm.vel_scale * dm.modal_scale);
+    sc(NX) = dm.pos_scale;
+    sc(NX + 1) = dm.vel_scale;
+    return sc;
+  }
+
+  // Error of a sub-step relative to those scales (energies excluded), and
+  // of t and (in a contact) q; rtol_scale = rtol * error_scale(m).
+  S error_norm(const Vec& e, const Vec& y0, const Vec& y1, S rtol,
+               const Eigen::Array<S, NX + 2, 1>& rtol_scale) const {
+    const auto ey = e.template head<NX + 2>().array().abs();
+    const auto mag = y0.template head<NX + 2>().array().abs().max(y1.template head<NX + 2>().array().abs());
+    const S worst = (ey / (rtol_scale + rtol * mag)).maxCoeff();
+    const S rt = numeric::abs_of(e(kT)) / (rtol * m.hs);
+    const S rq = regular() ? numeric::abs_of(e(kQ)) / (rtol * m.dev.q_scale) : S(0);
+    const S all = numeric::max_of(worst, numeric::max_of(rt, rq));
+    return std::isfinite(all + ey.sum()) ? all : std::numeric_limits<S>::infinity();
   }
 };
 
@@ -324,6 +332,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   const int cap = m.loop.max_substeps_per_step;
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
+  const Eigen::Array<S, NX + 2, 1> rtol_scale = rtol * Stepper::error_scale(m);
   Vec y;
   y.template head<NX>() = d.z;
   y(NX) = d.s;
@@ -365,6 +374,8 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   };
 
   int immediate = 0;
+  S ln_en_old = std::log(S(1e-4));  // error of the last accepted sub-step (PI control)
+  bool rejected_last = false;
   while (y(kT) < h) {
     // An event already due at the start of the sub-step (the state sits on
     // the far side of a switching surface within rounding): apply it now.
@@ -387,11 +398,12 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     else if (forced) hs = (h - y(kT)) / std::fmax(f(kT), kEps);  // to t = h at the current rate
     else hs = hc_w;
     auto r = numeric::dopri5_step<Vec>(st, u, y, f, hs);
-    const S en = st.error_norm(r.err, y, r.y, rtol);
+    const S en = st.error_norm(r.err, y, r.y, rtol, rtol_scale);
     ++n;
     if (!forced && !(en <= S(1))) {
       ++d.count.rejected;
       (reg ? hc_w : hc_t) = hs * std::fmax(S(0.1), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2)));
+      rejected_last = true;
       continue;
     }
     if (forced) capped = true;
@@ -419,13 +431,16 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
 
     if (any && theta <= S(1)) {
-      // Place the event: Illinois iterations on the true sub-step, bracket
-      // [0, hs], starting from the cubic's estimate. The step end (side 0)
-      // is placed to rounding of t.
+      // Place the event on the true sub-step, bracket [0, hs], from the
+      // cubic's estimate: Newton steps on the event function (its slope comes
+      // with each trial step) aimed at the middle of the acceptance band
+      // [0, tol], Illinois steps where Newton would leave the bracket. The
+      // step end (side 0) is placed to rounding of t.
       const S tol = side == 0 ? S(4) * kEps * h : event_tol;
-      S lo = S(0), hi = hs, glo, ghi, slope;
-      glo = event_value(y, f, side, &slope);
-      ghi = S(1);
+      S lo = S(0), hi = hs, slope;
+      S glo = event_value(y, f, side, &slope);
+      S ghi = event_value(r.y, r.f, side, &slope);
+      if (!(ghi > S(0))) ghi = S(1);
       S tau = theta * hs;
       auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
       int last = 0;
@@ -434,9 +449,12 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
         if (std::fabs(g) <= tol && g >= S(0)) break;
         if (g > S(0)) { hi = tau; ghi = g; if (last == 1) glo *= S(0.5); last = 1; }
         else { lo = tau; glo = g; if (last == -1) ghi *= S(0.5); last = -1; }
-        if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) { tau = hi; }
-        else {
-          tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
+        if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) {
+          tau = hi;
+        } else {
+          tau = slope > S(0) ? tau - (g - S(0.5) * tol) / slope : lo;
+          if (!(tau > lo && tau < hi))
+            tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
           if (!(tau > lo && tau < hi)) tau = S(0.5) * (lo + hi);
         }
         rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
@@ -478,8 +496,16 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
-    (reg ? hc_w : hc_t) =
-        hs * std::fmin(S(5), std::fmax(S(0.2), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2))));
+    {
+      // PI step-size control (Gustafsson; Hairer's DOPRI5 constants): no
+      // growth right after a rejection.
+      const S ln_en = std::log(std::fmax(en, S(1e-4)));
+      S fac = S(0.9) * std::exp(S(-0.17) * ln_en + S(0.04) * ln_en_old);
+      fac = std::fmin(rejected_last ? S(1) : S(5), std::fmax(S(0.2), fac));
+      (reg ? hc_w : hc_t) = hs * fac;
+      ln_en_old = ln_en;
+      rejected_last = false;
+    }
     if (forced || y(kT) >= h * (S(1) - S(8) * kEps)) break;
   }
   if (capped) ++d.count.cap_hits;
@@ -496,7 +522,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   d.ledger.contact += static_cast<double>(y(NX + 2));
   d.ledger.input += static_cast<double>(y(NX + 3));
   d.ledger.damping += static_cast<double>(y(NX + 4));
-  d.elastic_energy += static_cast<double>(y(NX + 5));
+  d.ee_sum += static_cast<double>(y(NX + 5));
   S fp, loss;
   st.force(y, &fp, &loss);
   d.contact_force = fp;
