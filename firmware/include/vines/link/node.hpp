@@ -180,10 +180,14 @@ class Node {
     else why = validate_node(cfg);
     if (why) copy_message(why);
     else if (!plant_->configure(cfg, status_.message, sizeof status_.message)) why = status_.message;
-    if (why) return fault(FaultCode::kConfig, 0, 1);
+    if (why) {
+      fault(FaultCode::kConfig, 0, 1);
+      return send_status();  // with the reason
+    }
     cfg_ = cfg;
     h_ = 1.0 / cfg.scene.loop.sensor_rate_hz;
     status_.state = NodeState::kConfigured;
+    send_status();
   }
 
   void on_start(const Start& s) {
