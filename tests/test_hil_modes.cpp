@@ -27,28 +27,36 @@ HilOptions base(const char* mode, double duration_s) {
   return o;
 }
 
-// The twin of the nominal building: residual zero on the nominal truth, and
-// growing with the damage of the measured one (eta_k 0.95, 0.85, 0.7), with
-// its alarm raised.
+// The twin of the nominal building, fed the top-floor acceleration of the
+// measured one (with 0.02 m/s^2 sensor noise): on the nominal building the
+// residual is the noise and no alarm is raised; it grows with the damage
+// (eta_k 0.95, 0.85, 0.7) and raises the alarm. With the VI NES the residual
+// is dominated by impacts that the damaged building times differently.
 TEST(HilTwin, ResidualGrowsWithDamageAndRaisesTheAlarm) {
-  double last = -1;
-  for (double eta : {1.0, 0.95, 0.85, 0.7}) {
-    HilOptions o = base("twin", 20.0);
-    o.truth_stiffness_scale = eta;
-    o.residual_limit_mps2 = 0.1;
-    const nlohmann::json j = run_hil(vines_scene(), o);
-    const auto& t = j["twin"];
-    SCOPED_TRACE(t.dump());
-    const double rms = t["residual_rms_mps2"].get<double>();
-    if (eta == 1.0) {
-      EXPECT_EQ(rms, 0.0);  // the same model measured and predicted
-      EXPECT_EQ(t["residual_alarm_steps"].get<long long>(), 0);
-    } else {
-      EXPECT_GT(rms, last * 1.5);
-      if (eta <= 0.85) EXPECT_GT(t["residual_alarm_steps"].get<long long>(), 0);
+  for (const char* scene : {"elcentro_bare", "elcentro_vines"}) {
+    double last = -1;
+    for (double eta : {1.0, 0.95, 0.85, 0.7}) {
+      HilOptions o = base("twin", 20.0);
+      o.truth_stiffness_scale = eta;
+      o.measure_noise_mps2 = 0.02;
+      o.residual_limit_mps2 = 0.1;
+      const nlohmann::json j =
+          run_hil(load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/" + scene + ".toml"), o);
+      const auto& t = j["twin"];
+      SCOPED_TRACE(std::string(scene) + ": " + t.dump());
+      const double rms = t["residual_rms_mps2"].get<double>();
+      if (eta == 1.0) {
+        EXPECT_NEAR(rms, 0.02, 0.002);  // the noise alone
+        EXPECT_EQ(t["residual_alarm_steps"].get<long long>(), 0);
+      } else {
+        EXPECT_GT(rms, last);
+        EXPECT_GT(rms, 0.5);
+        EXPECT_GT(t["residual_alarm_steps"].get<long long>(), 0);
+        EXPECT_LT(t["first_residual_alarm_s"].get<double>(), 3.0);
+      }
+      EXPECT_TRUE(j["bit_exact"].get<bool>());  // predictions: the offline run of the nominal model
+      last = rms;
     }
-    EXPECT_TRUE(j["bit_exact"].get<bool>());  // predictions: the offline run of the nominal model
-    last = rms;
   }
 }
 
@@ -63,6 +71,10 @@ TEST(HilTwin, DriftAlarmsNameTheStories) {
   EXPECT_EQ(run_hil(vines_scene(), o)["twin"]["drift_alarm_steps"].get<long long>(), 0);
 }
 
+// A 20 Hz servo with 5 ms delay: extrapolating the command over the delay and
+// the servo's lag cuts the tracking error; the VI NES's impacts (overlaps of
+// a few mm) are so sensitive to the table's error that the hybrid response
+// still departs from the pure simulation; it stays bounded.
 TEST(HilHybrid, CompensationReducesTrackingError) {
   HilOptions with = base("hybrid", 20.0), without = base("hybrid", 20.0);
   without.comp_delay_s = 0;
@@ -70,11 +82,28 @@ TEST(HilHybrid, CompensationReducesTrackingError) {
   const auto &ha = a["hybrid"], &hb = b["hybrid"];
   SCOPED_TRACE(ha.dump() + "\n" + hb.dump());
   EXPECT_GT(ha["compensation_delay_s"].get<double>(), 0.005);
-  EXPECT_LT(ha["tracking_rms_m"].get<double>(), 0.5 * hb["tracking_rms_m"].get<double>());
-  EXPECT_TRUE(a["outputs_finite"].get<bool>());
-  // The hybrid top floor follows the pure simulation to within a fraction of its peak.
-  EXPECT_LT(ha["top_diff_from_pure_rms_m"].get<double>(), 0.2 * ha["peak_top_pure_m"].get<double>());
-  EXPECT_GT(ha["top_diff_from_pure_rms_m"].get<double>(), 0.0);
+  EXPECT_LT(ha["tracking_rms_m"].get<double>(), 0.2 * hb["tracking_rms_m"].get<double>());
+  EXPECT_LT(ha["tracking_peak_m"].get<double>(), hb["tracking_peak_m"].get<double>());
+  for (const auto* j : {&a, &b}) {
+    EXPECT_TRUE((*j)["outputs_finite"].get<bool>());
+    EXPECT_LT((*j)["hybrid"]["peak_top_hybrid_m"].get<double>(), 2 * (*j)["hybrid"]["peak_top_pure_m"].get<double>());
+  }
+}
+
+// With a near-ideal actuator (2 kHz, no delay, no sensor noise) the hybrid
+// peak comes within 5 % of the pure simulation's: the coupling is right.
+TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
+  HilOptions o = base("hybrid", 20.0);
+  o.actuator_hz = 2000;
+  o.actuator_delay_s = 0;
+  o.force_noise_n = 0;
+  o.force_lsb_n = 0;
+  o.comp_delay_s = 0.001;  // the one-step lag of the command
+  const nlohmann::json j = run_hil(vines_scene(), o);
+  const auto& hy = j["hybrid"];
+  EXPECT_NEAR(hy["peak_top_hybrid_m"].get<double>(), hy["peak_top_pure_m"].get<double>(),
+              0.05 * hy["peak_top_pure_m"].get<double>())
+      << hy.dump();
 }
 
 TEST(HilHybrid, RefusesAnInstantaneousLaw) {
