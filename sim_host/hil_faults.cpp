@@ -69,7 +69,9 @@ std::vector<FaultEvent> plan_faults(const HilOptions& opt, long long samples) {
       for (long long j = k; j <= k + span && free; ++j) free = !busy[static_cast<std::size_t>(j)];
       if (!free) continue;
       for (long long j = k; j <= k + span; ++j) busy[static_cast<std::size_t>(j)] = 1;
-      FaultEvent ev{kind, k};
+      FaultEvent ev;
+      ev.kind = kind;
+      ev.k = k;
       ev.span = span;
       out.push_back(ev);
       break;

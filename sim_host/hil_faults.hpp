@@ -10,8 +10,8 @@
 namespace vines::host {
 
 struct FaultEvent {
-  FaultKind kind;
-  long long k;        // first sample affected
+  FaultKind kind = FaultKind::kDrop;
+  long long k = 0;    // first sample affected
   int span = 1;       // samples it covers (stall: S; late: L periods of delay)
   // Filled while running:
   long long life = 0;          // which node process it hit
