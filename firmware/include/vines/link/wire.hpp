@@ -1,0 +1,93 @@
+// Little-endian field writer and reader over caller-owned buffers. Neither
+// ever touches a byte outside its buffer: a write past the end or a read past
+// the end sets a sticky flag (checked once after a whole message) instead.
+// Doubles travel as their IEEE-754 bits, so values cross the link bit for bit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+namespace vines::link {
+
+class Writer {
+ public:
+  Writer(std::uint8_t* buf, std::size_t cap) : buf_(buf), cap_(cap) {}
+  void u8(std::uint8_t v) { put(v, 1); }
+  void u16(std::uint16_t v) { put(v, 2); }
+  void u32(std::uint32_t v) { put(v, 4); }
+  void u64(std::uint64_t v) { put(v, 8); }
+  void f64(double v) {
+    std::uint64_t b;
+    std::memcpy(&b, &v, 8);
+    put(b, 8);
+  }
+  void bytes(const std::uint8_t* p, std::size_t n) {
+    if (n > cap_ - len_) {
+      overflow_ = true;
+      return;
+    }
+    std::memcpy(buf_ + len_, p, n);
+    len_ += n;
+  }
+  std::size_t size() const { return len_; }
+  bool ok() const { return !overflow_; }
+
+ private:
+  void put(std::uint64_t v, std::size_t n) {
+    if (n > cap_ - len_) {
+      overflow_ = true;
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) buf_[len_++] = static_cast<std::uint8_t>(v >> (8 * i));
+  }
+  std::uint8_t* buf_;
+  std::size_t cap_, len_ = 0;
+  bool overflow_ = false;
+};
+
+class Reader {
+ public:
+  Reader(const std::uint8_t* buf, std::size_t n) : buf_(buf), n_(n) {}
+  std::uint8_t u8() { return static_cast<std::uint8_t>(get(1)); }
+  std::uint16_t u16() { return static_cast<std::uint16_t>(get(2)); }
+  std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
+  std::uint64_t u64() { return get(8); }
+  double f64() {
+    const std::uint64_t b = get(8);
+    double v;
+    std::memcpy(&v, &b, 8);
+    return v;
+  }
+  // Points at the next n bytes (nullptr and the error flag if there are fewer).
+  const std::uint8_t* bytes(std::size_t n) {
+    if (n > n_ - pos_) {
+      error_ = true;
+      return nullptr;
+    }
+    const std::uint8_t* p = buf_ + pos_;
+    pos_ += n;
+    return p;
+  }
+  std::size_t remaining() const { return n_ - pos_; }
+  // Everything read was there, and nothing is left over.
+  bool done() const { return !error_ && pos_ == n_; }
+  bool ok() const { return !error_; }
+
+ private:
+  std::uint64_t get(std::size_t n) {
+    if (n > n_ - pos_) {
+      error_ = true;
+      pos_ = n_;
+      return 0;
+    }
+    std::uint64_t v = 0;
+    for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(buf_[pos_++]) << (8 * i);
+    return v;
+  }
+  const std::uint8_t* buf_;
+  std::size_t n_, pos_ = 0;
+  bool error_ = false;
+};
+
+}  // namespace vines::link

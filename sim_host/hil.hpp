@@ -1,0 +1,67 @@
+// `vines hil`: the hardware-in-the-loop bench. It runs the firmware node
+// (`vines node`, a child process) over the link protocol, streams a scene's
+// record at the sensor rate in real time or lock-step with a virtual clock,
+// injects link and sensor faults, and compares the telemetry with the offline
+// run. Modes: replay (the scene as `vines run` runs it), twin (digital-twin
+// monitor against a bench truth model, possibly damaged), hybrid (shake-table
+// real-time hybrid simulation with an actuator and the VI NES on the table).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sim_host/scene.hpp"
+
+namespace vines::host {
+
+// When a fault is injected: with a probability per sample, or at samples.
+struct FaultSpec {
+  double rate = 0;
+  std::vector<long long> at;
+  bool any() const { return rate > 0 || !at.empty(); }
+};
+
+enum class FaultKind { kDrop, kCorrupt, kDuplicate, kReorder, kLate, kNonFinite, kSaturate, kStall, kRestart, kCount };
+inline constexpr int kFaultKinds = static_cast<int>(FaultKind::kCount);
+const char* fault_kind_name(FaultKind k);
+
+struct HilOptions {
+  std::string mode = "replay";  // replay | twin | hybrid
+  bool realtime = false;
+  double duration_s = 0;        // 0: the scene's
+  std::string csv;              // "" : none
+  double timeout_s = 5;         // longest wait for the node
+  double deadline_periods = 1;  // telemetry k due by (k + this) h
+  unsigned long long seed = 1;
+  FaultSpec faults[kFaultKinds];
+  int late_periods = 3, stall_periods = 20;
+  double saturate_g = 0;        // sensor range (0: none)
+  // node fault policy
+  double grace_periods = 1.5, node_stall_periods = 10;
+  // twin
+  double truth_stiffness_scale = 1;  // the bench's building (eta_k)
+  double measure_noise_mps2 = 0;
+  double drift_limit_m = 0;          // every story (0: no alarm)
+  double residual_limit_mps2 = 0.05;
+  double residual_window_s = 1.0;
+  // hybrid
+  double actuator_hz = 20, actuator_zeta = 0.7, actuator_delay_s = 0.005;
+  double force_noise_n = 50, force_lsb_n = 10;
+  double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
+  int comp_order = 2;
+  std::string node_command;  // "" : this program's `node` command
+};
+
+// Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.
+FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
+
+// Runs the bench; returns the report. Throws std::runtime_error naming the
+// input (scene, option, node) on any error the user can cause.
+nlohmann::json run_hil(const Scene& scene, const HilOptions& opt);
+
+// `vines node`: the host firmware node on stdin/stdout.
+int node_main(const std::vector<std::string>& args);
+
+}  // namespace vines::host

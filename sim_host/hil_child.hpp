@@ -1,0 +1,43 @@
+// A child process with pipes to its stdin and stdout (the host node of
+// `vines hil`). Every wait has a timeout; the child is killed and reaped by
+// the destructor at the latest.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vines::host {
+
+class ChildProcess {
+ public:
+  // Starts argv[0] with argv (throws std::runtime_error naming it on failure).
+  explicit ChildProcess(const std::vector<std::string>& argv);
+  ~ChildProcess();
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  // Writes everything or throws after timeout_s (child stuck or gone).
+  void write_all(const std::uint8_t* p, std::size_t n, double timeout_s);
+  // Appends what the child wrote within timeout_s (0: do not wait) to out;
+  // returns false once the child's stdout is closed.
+  bool read_some(std::vector<std::uint8_t>* out, double timeout_s);
+  // Closes its stdin and waits up to timeout_s for it to exit, then kills it.
+  // Returns its exit status (128 + signal if killed).
+  int finish(double timeout_s);
+  // SIGKILL now (a firmware crash / power cut), and reap it.
+  void kill_now();
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_ = -1;
+  int in_ = -1, out_ = -1;  // our ends: its stdin, its stdout
+  int status_ = -1;
+};
+
+// This program's own path (to run `vines node`).
+std::string self_exe();
+
+}  // namespace vines::host

@@ -1,0 +1,26 @@
+// The bench's fault plan: which samples get which fault, drawn once from the
+// options (rates with a seeded generator, or given samples), one fault per
+// sample and none inside another fault's window.
+#pragma once
+
+#include <vector>
+
+#include "sim_host/hil.hpp"
+
+namespace vines::host {
+
+struct FaultEvent {
+  FaultKind kind = FaultKind::kDrop;
+  long long k = 0;    // first sample affected
+  int span = 1;       // samples it covers (stall: S; late: L periods of delay)
+  // Filled while running:
+  long long life = 0;          // which node process it hit
+  std::vector<unsigned> seqs;  // link sequence numbers of its frames (drop, corrupt, duplicate, reorder)
+  bool detected = false, survived = false;
+};
+
+// Faults for samples 1 .. samples-1, in sample order. Windows that would run
+// past the end are not drawn.
+std::vector<FaultEvent> plan_faults(const HilOptions& opt, long long samples);
+
+}  // namespace vines::host

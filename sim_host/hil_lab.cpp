@@ -1,0 +1,68 @@
+#include "sim_host/hil_lab.hpp"
+
+#include <cmath>
+
+#include "vines/contact.hpp"
+
+namespace vines::host {
+
+ShakeTable::ShakeTable(const VinesDesign& d, ContactLaw law, double particle_x0, double particle_v0, double h,
+                       const LabOptions& opt)
+    : d_(d), law_(law), h_(h), opt_(opt), rng_(opt.seed) {
+  sub_ = static_cast<int>(std::ceil(h / 20e-6));
+  const double dt = h / sub_;
+  pipeline_.assign(static_cast<std::size_t>(std::llround(opt.delay_s / dt)), 0.0);
+  s_ = particle_x0;
+  sd_ = particle_v0;
+}
+
+double ShakeTable::contact_force(double s, double sd, double xt, double vt) const {
+  auto kernel = [&](double d, double dd) {
+    switch (law_) {
+      case ContactLaw::kHertz: return contact::Hertz<double>{d_.c}(d, dd).total();
+      case ContactLaw::kTsuji: return contact::Tsuji<double>{d_.c, d_.g}(d, dd).total();
+      case ContactLaw::kKuwabara: return contact::Kuwabara<double>{d_.c, d_.g}(d, dd).total();
+      default: return 0.0;  // restitution: refused by the bench (a load cell sees no impulse)
+    }
+  };
+  const double left = (xt - d_.gap) - s, right = s - (xt + d_.gap);
+  if (left > 0) return kernel(left, vt - sd);
+  if (right > 0) return -kernel(right, sd - vt);
+  return 0.0;
+}
+
+double ShakeTable::advance(double command, double a0, double a1) {
+  const double dt = h_ / sub_;
+  const double w = 2 * M_PI * opt_.actuator_hz, z = opt_.actuator_zeta;
+  for (int i = 0; i < sub_; ++i) {
+    pipeline_.push_back(command);
+    const double u = pipeline_.front();
+    pipeline_.pop_front();
+    // y = (x, v, s, sd); ground acceleration linear over the period.
+    auto f = [&](const double* y, double t, double* dy) {
+      const double ag = a0 + (a1 - a0) * t / h_;
+      dy[0] = y[1];
+      dy[1] = w * w * (u - y[0]) - 2 * z * w * y[1];
+      dy[2] = y[3];
+      dy[3] = -ag + contact_force(y[2], y[3], y[0], y[1]) / d_.mass;
+    };
+    const double t = i * dt, y0[4] = {x_, v_, s_, sd_};
+    double k1[4], k2[4], k3[4], k4[4], y[4];
+    f(y0, t, k1);
+    for (int j = 0; j < 4; ++j) y[j] = y0[j] + 0.5 * dt * k1[j];
+    f(y, t + 0.5 * dt, k2);
+    for (int j = 0; j < 4; ++j) y[j] = y0[j] + 0.5 * dt * k2[j];
+    f(y, t + 0.5 * dt, k3);
+    for (int j = 0; j < 4; ++j) y[j] = y0[j] + dt * k3[j];
+    f(y, t + dt, k4);
+    x_ = y0[0] + dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]);
+    v_ = y0[1] + dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]);
+    s_ = y0[2] + dt / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
+    sd_ = y0[3] + dt / 6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]);
+  }
+  contact_ = contact_force(s_, sd_, x_, v_);
+  const double measured = -contact_ + opt_.force_noise_n * noise_(rng_);
+  return opt_.force_lsb_n > 0 ? opt_.force_lsb_n * std::round(measured / opt_.force_lsb_n) : measured;
+}
+
+}  // namespace vines::host

@@ -1,0 +1,34 @@
+// The plant a host node runs (the firmware node's Plant, link/node.hpp): the
+// scene's compiled firmware instance (replay and twin modes), or the bare
+// frame with the table's measured force (hybrid mode), chosen at configure.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "sim_host/engine.hpp"
+#include "vines/link/config.hpp"
+#include "vines/link/hybrid_frame.hpp"
+#include "vines/link/messages.hpp"
+
+namespace vines::host {
+
+// The modal data of a bare frame, from a built engine's model info.
+link::ModalData modal_data(const ModelInfo& info);
+
+class HostPlant {
+ public:
+  bool configure(const link::NodeConfig& c, char* msg, std::size_t cap);
+  void init(double a0, double f0);
+  void step(double a1, double f1);
+  void read(link::Telemetry* t);
+
+ private:
+  link::NodeMode mode_ = link::NodeMode::kReplay;
+  int n_ = 0;
+  std::unique_ptr<Engine> engine_;
+  link::HybridFrame<double> hybrid_;
+  long long guard_events_ = 0;  // core guard counters at the last read
+};
+
+}  // namespace vines::host
