@@ -96,9 +96,12 @@ __attribute__((noreturn)) static void vines_fault(const char* what, int code) {
   vines_put_hex(VINES_REG(0xE000ED34));
   vines_semihost_puts(" BFAR ");
   vines_put_hex(VINES_REG(0xE000ED38));
-  /* The stacked PC, unless the process stack itself is what overflowed. */
-  if (psp >= (uint32_t)(uintptr_t)__stack_guard + (uint32_t)(uintptr_t)__stack_guard_size + 32u) {
-    vines_semihost_puts(" PC ");
+  vines_semihost_puts(" PSP ");
+  vines_put_hex(psp);
+  /* The PC stacked on the process stack, unless that stack is what overflowed. */
+  if (psp >= (uint32_t)(uintptr_t)__stack_guard + (uint32_t)(uintptr_t)__stack_guard_size + 32u &&
+      psp + 32u <= (uint32_t)(uintptr_t)__stack_top) {
+    vines_semihost_puts(" stacked PC ");
     vines_put_hex(((const uint32_t*)(uintptr_t)psp)[6]);
   }
   vines_semihost_puts("\n");
