@@ -98,7 +98,7 @@ def run_scene(target, board, scalar, device):
            "--image", os.path.join(build, "firmware", "app", f"vines_mcu_loop_{device}.elf"),
            "--feed-tool", os.path.join(ROOT, "build", "release", "vines_feed"),
            "--scene", os.path.join(ROOT, "data", "scenes", f"elcentro_{device}.toml"),
-           "--scalar", scalar, "--rtol", "1", "--count-tol", "1000000", "--json"]
+           "--scalar", scalar, "--rtol", "1", "--count-rtol", "1e6", "--json"]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise Failure(f"{target} {device}: scene run failed:\n{r.stderr.strip()}")

@@ -15,7 +15,7 @@ it against the host build of the same source.
    With --board host the image is the host build of the same loop (stdin),
    whose ticks are nanoseconds of the host's clock.
 3. The image's summary must match the host's within --rtol (relative;
-   counts within --count-tol), and its deadline monitor must count exactly
+   counts within --count-rtol), and its deadline monitor must count exactly
    the steps whose measured ticks exceed its budget.
 Prints the comparison and the cost per step; --json prints one JSON object
 (the figures tools/mcu_report.py reports). Exit status 0 only if every check
@@ -23,6 +23,7 @@ passes; any error is a message, never a traceback.
 """
 import argparse
 import json
+import math
 import os
 import statistics
 import struct
@@ -106,7 +107,8 @@ def main():
     ap.add_argument("--scene", required=True)
     ap.add_argument("--scalar", required=True, choices=["float", "double"])
     ap.add_argument("--rtol", type=float, required=True)
-    ap.add_argument("--count-tol", type=int, default=0)
+    ap.add_argument("--count-rtol", type=float, default=0.0,
+                    help="counts may differ by ceil(this * host count)")
     ap.add_argument("--budget-ticks", type=int, default=0)
     ap.add_argument("--expect-overruns", action="store_true")
     ap.add_argument("--duration", type=float, default=0.0)
@@ -148,7 +150,7 @@ def main():
             bad.append(f"{key}: missing ({'host' if h is None else 'image'})")
             continue
         if (key, path) in COUNTED:
-            ok, diff = abs(m - h) <= a.count_tol, abs(m - h)
+            ok, diff = abs(m - h) <= math.ceil(a.count_rtol * abs(h)), abs(m - h)
         else:
             diff = abs(m - h) / max(abs(h), 1e-300)
             ok = diff <= a.rtol
