@@ -22,6 +22,10 @@
 #include "vines/hal/port.hpp"
 #include "vines/sim.hpp"
 
+// Eigen's data layout is the same on every target (host x86-64 with SSE2,
+// Cortex-M without SIMD): fixed-size objects 16-byte aligned.
+static_assert(EIGEN_MAX_STATIC_ALIGN_BYTES == 16, "Eigen alignment differs from the other targets");
+
 namespace {
 
 using Scalar = VINES_APP_SCALAR;
