@@ -11,6 +11,7 @@
 namespace {
 
 constexpr std::uint32_t kPclkHz = 25000000u;  // MPS2 SYSCLK (APB clock of the timers)
+constexpr std::uint32_t kLinkTimeoutS = 30u;   // a silent link is an error, not a hang
 
 struct Uart {
   volatile std::uint32_t data, state, ctrl, intstatus, bauddiv;
@@ -59,7 +60,12 @@ void port_init() {
 bool link_read(void* dst, std::size_t n) {
   auto* p = static_cast<std::uint8_t*>(dst);
   for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t start = counter_now();
     while (!(uart0().state & kRxFull)) {
+      if (counter_now() - start > kLinkTimeoutS * kPclkHz) {
+        g_error = "UART0: no byte for 30 s (the stream ended or stalled)";
+        return false;
+      }
     }
     if (uart0().state & kRxOverrun) {
       g_error = "UART0 receive overrun (a byte was lost)";
