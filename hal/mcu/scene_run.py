@@ -114,6 +114,8 @@ def main():
     ap.add_argument("--expect-overruns", action="store_true")
     ap.add_argument("--duration", type=float, default=0.0)
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--cut-after", type=int, default=0, metavar="BYTES",
+                    help="feed only the first BYTES of the stream: the image must report it and stop")
     a = ap.parse_args()
 
     for path, what in ((a.image, "image"), (a.scene, "scene")):
@@ -136,9 +138,17 @@ def main():
         cmd = [a.image] if a.board == "host" else [
             os.path.join(HERE, "qemu.sh"), a.board, a.image, "-serial", "stdio",
             "-icount", f"shift={ICOUNT_SHIFT},align=off,sleep=off"]
+        if a.cut_after:
+            with open(feed, "r+b") as f:
+                f.truncate(a.cut_after)
         with open(feed, "rb") as f:
             q = run(cmd, stdin=f, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     sys.stderr.write(q.stderr.decode(errors="replace"))
+    if a.cut_after:
+        if q.returncode == 1 and b"cut short" in q.stderr:
+            print(f"stream cut after {a.cut_after} bytes: reported, exit status 1")
+            return 0
+        raise Failure(f"stream cut after {a.cut_after} bytes: exit status {q.returncode}, not reported")
     if q.returncode != 0:
         raise Failure(f"the image exited with status {q.returncode}")
     steps, mcu = parse_telemetry(q.stdout.decode(errors="replace"))
