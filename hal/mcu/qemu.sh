@@ -3,7 +3,8 @@
 # (semihosting SYS_EXIT_EXTENDED) is this script's. ctest uses it as
 # CMAKE_CROSSCOMPILING_EMULATOR (cmake/arm-none-eabi-common.cmake).
 #   qemu.sh BOARD IMAGE.elf [QEMU_OPTION...]
-# BOARD: mps2-an386 (Cortex-M4F) or mps2-an500 (Cortex-M7). Extra options go
+# BOARD: mps2-an386 (Cortex-M4F), mps2-an500 (Cortex-M7) or mps2-an385
+# (Cortex-M3, no FPU: the fixed-point image). Extra options go
 # to QEMU (e.g. -serial file:OUT, -icount shift=0); without a -serial option,
 # UART0 is not connected. Semihosting output goes to stderr. The run is
 # killed after VINES_QEMU_TIMEOUT seconds (default 600).
@@ -15,8 +16,8 @@ fi
 board=$1 image=$2
 shift 2
 case $board in
-  mps2-an386 | mps2-an500) ;;
-  *) echo "qemu.sh: unknown board '$board' (mps2-an386 or mps2-an500)" >&2; exit 2 ;;
+  mps2-an385 | mps2-an386 | mps2-an500) ;;
+  *) echo "qemu.sh: unknown board '$board' (mps2-an385, mps2-an386 or mps2-an500)" >&2; exit 2 ;;
 esac
 if [[ ! -f $image ]]; then
   echo "qemu.sh: $image: no such image (build it first)" >&2
