@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages the project needs: host build and tests,
-# the Cortex-M4F cross build, QEMU for the MCU image, and the plot script's
+# the Cortex-M4F and M7 cross builds, QEMU for the MCU images, and the plot script's
 # Python libraries. Installs only what is missing, so it is cheap to re-run.
 # Root or sudo; no questions asked (usable with no stdin, as in CI).
 set -euo pipefail
@@ -9,9 +9,9 @@ packages=(
   cmake make g++                                 # host build
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
-  gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f preset
+  gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
-  qemu-system-arm                                # runs the MCU image
+  qemu-system-arm                                # runs the MCU images (ctest)
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
   libsundials-dev                                # CVODE baseline (vines reference, tests)

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The project's test command. Host: build and run the unit tests (preset
-# release). MCU: build the Cortex-M4F image (preset cortex-m4f; the build also
-# proves that the link refuses the heap) and, when qemu-system-arm is
-# installed, run the smoke image on the emulated MPS2-AN386 board.
+# release). MCU: for each target (presets cortex-m4f and cortex-m7), build the
+# images (the build also proves that the link refuses the heap) and run the
+# MCU tests in QEMU (ctest --preset <target>): the smoke image, the
+# stack-overflow fault, the El Centro VI NES and TMD scenes fed over the UART
+# and compared with the host build above, and the deadline monitor.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -12,11 +14,9 @@ cmake --preset release
 cmake --build --preset release -j2
 ctest --preset release
 
-cmake --preset cortex-m4f
-cmake --build --preset cortex-m4f -j2
-if command -v qemu-system-arm >/dev/null; then
-  cmake --build --preset cortex-m4f --target vines_mcu_smoke_qemu
-else
-  echo "test.sh: qemu-system-arm not installed: MCU image built, not run" >&2
-fi
+for target in cortex-m4f cortex-m7; do
+  cmake --preset "$target"
+  cmake --build --preset "$target" -j2
+  ctest --preset "$target"
+done
 echo "test.sh: all passed"

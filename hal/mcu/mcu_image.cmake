@@ -1,7 +1,13 @@
-# Rules shared by every bare-metal image (the smoke image here, the heap probe
-# in heap_probe/, later QEMU test images): startup code, linker script for the
-# MPS2-AN386 board, and the heap ban.
+# Rules shared by every bare-metal image (the images here and the heap probe
+# in heap_probe/): startup code, the board's linker script (VINES_MCU_BOARD,
+# from the toolchain file: mps2-an386 or mps2-an500), and the heap ban.
 set(VINES_MCU_DIR ${CMAKE_CURRENT_LIST_DIR})
+if(NOT VINES_MCU_BOARD MATCHES "^mps2-an(386|500)$")
+  message(FATAL_ERROR "VINES_MCU_BOARD='${VINES_MCU_BOARD}': configure with a Cortex-M preset "
+    "(cmake --preset cortex-m4f or cortex-m7)")
+endif()
+string(REPLACE "-" "_" VINES_MCU_LINKER_SCRIPT ${VINES_MCU_BOARD})
+set(VINES_MCU_LINKER_SCRIPT ${VINES_MCU_DIR}/${VINES_MCU_LINKER_SCRIPT}.ld)
 find_program(VINES_MCU_SIZE_TOOL arm-none-eabi-size REQUIRED)
 
 # Heap ban. Every allocator entry point of newlib and every C++ operator
@@ -30,11 +36,11 @@ function(vines_mcu_image target)
   target_sources(${target} PRIVATE ${VINES_MCU_DIR}/startup.c)
   target_include_directories(${target} PRIVATE ${VINES_MCU_DIR})
   target_link_options(${target} PRIVATE
-    -nostartfiles -T${VINES_MCU_DIR}/mps2_an386.ld
+    -nostartfiles -L${VINES_MCU_DIR} -T${VINES_MCU_LINKER_SCRIPT}
     -Wl,-Map=$<TARGET_FILE_DIR:${target}>/${target}.map
     ${VINES_MCU_NO_HEAP_LINK_OPTIONS})
   set_target_properties(${target} PROPERTIES
-    SUFFIX .elf LINK_DEPENDS ${VINES_MCU_DIR}/mps2_an386.ld)
+    SUFFIX .elf LINK_DEPENDS "${VINES_MCU_LINKER_SCRIPT};${VINES_MCU_DIR}/mps2_sections.ld")
   add_custom_command(TARGET ${target} POST_BUILD
     COMMAND ${VINES_MCU_SIZE_TOOL} $<TARGET_FILE:${target}>)
 endfunction()

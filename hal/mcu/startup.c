@@ -1,8 +1,8 @@
-/* Startup for the MPS2-AN386 image (Cortex-M4F): vector table, reset handler
- * (FPU on, thread mode on the process stack, MPU stack guard, .data/.bss,
- * constructors, main), fault handlers, and the C/C++ runtime hooks that would
- * otherwise pull stdio/heap code out of newlib and libstdc++. Symbols come
- * from mps2_an386.ld. Faults and failed checks end the run through
+/* Startup for the MPS2 images (AN386 Cortex-M4F, AN500 Cortex-M7): vector
+ * table, reset handler (FPU on, thread mode on the process stack, MPU stack
+ * guard, .data/.bss, constructors, main), fault handlers, and the C/C++
+ * runtime hooks that would otherwise pull stdio/heap code out of newlib and
+ * libstdc++. Symbols come from mps2_sections.ld. Faults and failed checks end the run through
  * semihosting (semihost.h) with a non-zero exit status; main's return value is
  * the exit status. */
 #include <stdint.h>
@@ -37,7 +37,7 @@ static void vines_enable_stack_guard(void) {
   VINES_REG(0xE000ED9C) = (uint32_t)(uintptr_t)__stack_guard;       /* MPU_RBAR */
   VINES_REG(0xE000EDA0) = (1u << 28)                                /* XN, AP = 0 */
                           | ((uint32_t)(__builtin_ctz(size) - 1) << 1) | 1u; /* SIZE, EN */
-  VINES_REG(0xE000ED24) |= 1u << 16;           /* SHCSR.MEMFAULTENA */
+  VINES_REG(0xE000ED24) |= 7u << 16;  /* SHCSR: MEMFAULTENA, BUSFAULTENA, USGFAULTENA */
   VINES_REG(0xE000ED94) = (1u << 2) | 1u;      /* MPU_CTRL: PRIVDEFENA | ENABLE */
   __asm__ volatile("dsb\n\tisb" ::: "memory");
 }
@@ -75,11 +75,48 @@ __attribute__((naked, noreturn)) void Reset_Handler(void) {
       ".ltorg\n\t");
 }
 
-void HardFault_Handler(void) { vines_fail("HardFault", 3); }
-void MemManage_Handler(void) { vines_fail("MemManage fault (stack overflow into the guard?)", 8); }
-void Default_Handler(void) { vines_fail("unexpected exception", 4); }
+/* Prints the fault status registers (CFSR, HFSR, MMFAR/BFAR) and the
+ * faulting PC from the exception frame, then ends the run. */
+static void vines_put_hex(uint32_t v) {
+  char buf[11] = "0x";
+  for (int i = 0; i < 8; ++i) buf[2 + i] = "0123456789abcdef"[(v >> (28 - 4 * i)) & 0xFu];
+  buf[10] = '\0';
+  vines_semihost_puts(buf);
+}
+__attribute__((noreturn)) static void vines_fault(const char* what, int code) {
+  uint32_t psp;
+  __asm__ volatile("mrs %0, psp" : "=r"(psp));
+  vines_semihost_puts("vines mcu: ");
+  vines_semihost_puts(what);
+  vines_semihost_puts(": CFSR ");
+  vines_put_hex(VINES_REG(0xE000ED28));
+  vines_semihost_puts(" HFSR ");
+  vines_put_hex(VINES_REG(0xE000ED2C));
+  vines_semihost_puts(" MMFAR ");
+  vines_put_hex(VINES_REG(0xE000ED34));
+  vines_semihost_puts(" BFAR ");
+  vines_put_hex(VINES_REG(0xE000ED38));
+  vines_semihost_puts(" PSP ");
+  vines_put_hex(psp);
+  /* The PC stacked on the process stack, unless that stack is what overflowed. */
+  if (psp >= (uint32_t)(uintptr_t)__stack_guard + (uint32_t)(uintptr_t)__stack_guard_size + 32u &&
+      psp + 32u <= (uint32_t)(uintptr_t)__stack_top) {
+    vines_semihost_puts(" stacked PC ");
+    vines_put_hex(((const uint32_t*)(uintptr_t)psp)[6]);
+  }
+  vines_semihost_puts("\n");
+  vines_semihost_exit(code);
+}
 
-/* Cortex-M vector table: initial SP, 15 system exceptions, 32 AN386 IRQs. */
+void HardFault_Handler(void) { vines_fault("HardFault", 3); }
+void MemManage_Handler(void) { vines_fault("MemManage fault (stack overflow into the guard?)", 8); }
+void BusFault_Handler(void) { vines_fault("BusFault", 9); }
+void UsageFault_Handler(void) { vines_fault("UsageFault", 10); }
+void Default_Handler(void) { vines_fail("unexpected exception", 4); }
+/* Peripheral handlers an image may define (port_mps2.cpp); unexpected otherwise. */
+void TIMER0_Handler(void) __attribute__((weak, alias("Default_Handler")));
+
+/* Cortex-M vector table: initial SP, 15 system exceptions, 32 IRQs. */
 struct vines_vector_table {
   uint32_t* initial_sp;
   vines_handler handler[15 + 32];
@@ -92,7 +129,7 @@ __attribute__((section(".isr_vector"), used)) const struct vines_vector_table vi
         Default_Handler,    /* NMI */
         HardFault_Handler,
         MemManage_Handler,
-        Default_Handler, Default_Handler,                   /* BusFault, UsageFault */
+        BusFault_Handler, UsageFault_Handler,
         0, 0, 0, 0,                                         /* reserved */
         Default_Handler,                                    /* SVCall */
         Default_Handler,                                    /* DebugMonitor */
@@ -100,6 +137,7 @@ __attribute__((section(".isr_vector"), used)) const struct vines_vector_table vi
         Default_Handler,                                    /* PendSV */
         Default_Handler,                                    /* SysTick */
         [15 ... 46] = Default_Handler,                      /* external IRQs */
+        [15 + 8] = TIMER0_Handler,                          /* CMSDK timer 0 */
     },
 };
 
@@ -116,6 +154,12 @@ void __assert_func(const char* file, int line, const char* func, const char* exp
   vines_semihost_puts(":");
   vines_semihost_put_int(line);
   vines_fail("", 7);
+}
+/* eigen_assert on the MCU (eigen_assert.h): stays active in release builds. */
+__attribute__((noreturn)) void vines_eigen_assert_fail(const char* expr, const char* file, int line) {
+  __assert_func(file, line, "", expr);
+  for (;;) {
+  }
 }
 /* Static destructors never run on bare metal: do not register them. */
 void* __dso_handle = 0;

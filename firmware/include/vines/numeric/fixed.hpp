@@ -1,0 +1,131 @@
+// Fixed-point scalar for FPU-less cores: Q(31-F).F in an int32, every
+// operation saturating (to the largest/smallest value; each saturation is
+// counted in fixed_saturations()), products rounded to nearest through a
+// 64-bit intermediate (one SMULL on a Cortex-M3/M4). With Eigen::NumTraits,
+// so Eigen arrays and the core's templates take it as their scalar.
+//
+// Its range is +-2^(31-F) and its resolution 2^-F: quantities must be scaled
+// to O(1) first. fixed_modal.hpp does this for the modal exact step (the
+// linear frame propagation); see there for where it is and is not fit.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Core>
+
+namespace vines::numeric {
+
+// How many operations saturated since the counter was last reset (single
+// core, no threads: a plain counter).
+inline std::uint32_t& fixed_saturations() {
+  static std::uint32_t count = 0;
+  return count;
+}
+
+template <int F>
+class Fixed {
+  static_assert(F > 0 && F < 31, "Q format: 1..30 fractional bits in an int32");
+
+ public:
+  using Raw = std::int32_t;
+  static constexpr int kFractionBits = F;
+  static constexpr double kOne = static_cast<double>(std::int64_t{1} << F);
+
+  Fixed() = default;
+  // From a real value: rounded to nearest, saturated (NaN gives 0).
+  explicit Fixed(double v) : raw_(from_double(v)) {}
+  explicit Fixed(int v) : raw_(saturate(static_cast<std::int64_t>(v) * (std::int64_t{1} << F))) {}
+  static Fixed from_raw(Raw r) {
+    Fixed x;
+    x.raw_ = r;
+    return x;
+  }
+
+  Raw raw() const { return raw_; }
+  explicit operator double() const { return static_cast<double>(raw_) / kOne; }
+  explicit operator float() const { return static_cast<float>(static_cast<double>(*this)); }
+
+  friend Fixed operator+(Fixed a, Fixed b) { return from_raw(saturate(std::int64_t{a.raw_} + b.raw_)); }
+  friend Fixed operator-(Fixed a, Fixed b) { return from_raw(saturate(std::int64_t{a.raw_} - b.raw_)); }
+  friend Fixed operator-(Fixed a) { return from_raw(saturate(-std::int64_t{a.raw_})); }
+  friend Fixed operator*(Fixed a, Fixed b) {
+    const std::int64_t p = std::int64_t{a.raw_} * b.raw_ + (std::int64_t{1} << (F - 1));
+    return from_raw(saturate(p >> F));  // arithmetic shift: floor, so + half rounds to nearest
+  }
+  friend Fixed operator/(Fixed a, Fixed b) {
+    if (b.raw_ == 0) return from_raw(saturate(a.raw_ >= 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62)));
+    return from_raw(saturate((std::int64_t{a.raw_} * (std::int64_t{1} << F)) / b.raw_));
+  }
+  Fixed& operator+=(Fixed b) { return *this = *this + b; }
+  Fixed& operator-=(Fixed b) { return *this = *this - b; }
+  Fixed& operator*=(Fixed b) { return *this = *this * b; }
+  Fixed& operator/=(Fixed b) { return *this = *this / b; }
+
+  friend bool operator==(Fixed a, Fixed b) { return a.raw_ == b.raw_; }
+  friend bool operator!=(Fixed a, Fixed b) { return a.raw_ != b.raw_; }
+  friend bool operator<(Fixed a, Fixed b) { return a.raw_ < b.raw_; }
+  friend bool operator>(Fixed a, Fixed b) { return a.raw_ > b.raw_; }
+  friend bool operator<=(Fixed a, Fixed b) { return a.raw_ <= b.raw_; }
+  friend bool operator>=(Fixed a, Fixed b) { return a.raw_ >= b.raw_; }
+
+  static Fixed max() { return from_raw(std::numeric_limits<Raw>::max()); }
+  static Fixed lowest() { return from_raw(std::numeric_limits<Raw>::min()); }
+  static Fixed epsilon() { return from_raw(1); }
+
+ private:
+  static Raw saturate(std::int64_t v) {
+    if (v > std::numeric_limits<Raw>::max()) {
+      ++fixed_saturations();
+      return std::numeric_limits<Raw>::max();
+    }
+    if (v < std::numeric_limits<Raw>::min()) {
+      ++fixed_saturations();
+      return std::numeric_limits<Raw>::min();
+    }
+    return static_cast<Raw>(v);
+  }
+  static Raw from_double(double v) {
+    if (!(v == v)) return 0;
+    const double scaled = v * kOne;
+    if (scaled >= 2147483647.0) return saturate(std::int64_t{1} << 40);
+    if (scaled <= -2147483648.0) return saturate(-(std::int64_t{1} << 40));
+    return static_cast<Raw>(scaled < 0 ? scaled - 0.5 : scaled + 0.5);  // to nearest, ties away
+  }
+
+  Raw raw_;
+};
+
+template <int F>
+Fixed<F> abs(Fixed<F> x) {
+  return x < Fixed<F>(0) ? -x : x;
+}
+
+}  // namespace vines::numeric
+
+namespace Eigen {
+
+template <int F>
+struct NumTraits<vines::numeric::Fixed<F>> : GenericNumTraits<vines::numeric::Fixed<F>> {
+  using Fx = vines::numeric::Fixed<F>;
+  using Real = Fx;
+  using NonInteger = Fx;
+  using Literal = Fx;
+  using Nested = Fx;
+  enum {
+    IsComplex = 0,
+    IsInteger = 0,
+    IsSigned = 1,
+    RequireInitialization = 0,
+    ReadCost = 1,
+    AddCost = 2,  // add, then the saturation test
+    MulCost = 4,  // 64-bit product, round, shift, saturation test
+  };
+  static Fx epsilon() { return Fx::epsilon(); }
+  static Fx dummy_precision() { return Fx::from_raw(16); }
+  static Fx highest() { return Fx::max(); }
+  static Fx lowest() { return Fx::lowest(); }
+  static int digits10() { return static_cast<int>(F * 0.30103); }
+};
+
+}  // namespace Eigen
