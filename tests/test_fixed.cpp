@@ -53,8 +53,8 @@ FixedRun run_fixed(double amplification) {
   for (double x : a) pga = std::fmax(pga, std::fabs(x));
   const auto scales = numeric::modal_scales<10>(m.modal.omega, m.modal.gamma, pga, amplification);
   const auto lq = numeric::scaled_modal<28, 10>(m.lti, scales);
-  using ZD = Eigen::Matrix<double, 20, 1>;
-  using ZQ = Eigen::Matrix<Q, 20, 1>;
+  using ZD = Model<double, 10, NoDevice>::VecX;  // modes padded to the build's SIMD width
+  using ZQ = Eigen::Matrix<Q, ZD::RowsAtCompileTime, 1>;
   ZD zd = ZD::Zero();
   ZQ zq;
   zq.setConstant(Q(0));

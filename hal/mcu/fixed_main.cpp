@@ -42,8 +42,9 @@ int main() {
   constexpr double kAmax = 3.0;  // bound of |ground| above
   const auto scales = vines::numeric::modal_scales<10>(g_model.modal.omega, g_model.modal.gamma, kAmax, 10.0);
   const auto lq = vines::numeric::scaled_modal<28, 10>(g_model.lti, scales);
-  Eigen::Matrix<double, 20, 1> zd = Eigen::Matrix<double, 20, 1>::Zero();
-  Eigen::Matrix<Q, 20, 1> zq;
+  using ZD = decltype(g_model)::VecX;
+  ZD zd = ZD::Zero();
+  Eigen::Matrix<Q, ZD::RowsAtCompileTime, 1> zq;
   zq.setConstant(Q(0));
   vines::numeric::fixed_saturations() = 0;
   constexpr long kSteps = 20000;

@@ -47,6 +47,10 @@ COMPARED = [
     ("E_r", ("E_r",)),
 ]
 RATIOS = ("x_r", "E_r")
+# Figures set by every impact of the record: in a chaotic VI NES run (float,
+# where two builds round differently) they are reported, not compared
+# (MODEL.md: compare scalars on the peak; E_r is reproducible to a point).
+CHAOTIC = ("elastic_energy_integral", "E_r", "contacts", "substep_steps")
 COUNTED = [("contacts", ("contacts",)), ("steps", ("counters", "steps")),
            ("substep_steps", ("counters", "substep_steps"))]
 
@@ -110,6 +114,8 @@ def main():
     ap.add_argument("--rtol", type=float, required=True)
     ap.add_argument("--count-rtol", type=float, default=0.0,
                     help="counts may differ by ceil(this * host count)")
+    ap.add_argument("--chaotic", action="store_true",
+                    help="report, do not compare, the figures every impact changes (E_e, E_r, counts)")
     ap.add_argument("--budget-ticks", type=int, default=0)
     ap.add_argument("--expect-overruns", action="store_true")
     ap.add_argument("--duration", type=float, default=0.0)
@@ -166,6 +172,8 @@ def main():
             # x_r, E_r are fractions (near 0 early in a record): absolute difference.
             diff = abs(m - h) / (1.0 if key in RATIOS else max(abs(h), 1e-300))
             ok = diff <= a.rtol
+        if a.chaotic and key in CHAOTIC:
+            ok = True
         rows.append((key, h, m, diff, ok))
         if not ok:
             bad.append(f"{key}: image {m!r} vs host {h!r}")
@@ -197,7 +205,8 @@ def main():
     else:
         print(f"{result['scene']} on {a.board} ({a.scalar}) vs host, rtol {a.rtol:g}:")
         for key, h, m, d, ok in rows:
-            print(f"  {key:30s} host {h:<24.17g} image {m:<24.17g} diff {d:.3g} {'ok' if ok else 'FAIL'}")
+            verdict = "chaotic, not compared" if a.chaotic and key in CHAOTIC else ("ok" if ok else "FAIL")
+            print(f"  {key:30s} host {h:<24.17g} image {m:<24.17g} diff {d:.3g} {verdict}")
         for kind in ("free", "contact"):
             c = result[kind]
             if c:

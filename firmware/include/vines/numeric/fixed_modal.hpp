@@ -47,13 +47,21 @@ ModalScales<P> modal_scales(const Eigen::Matrix<double, P, 1>& omega, const Eige
   return s;
 }
 
-// The double step's coefficients in scaled units, in Q(31-F).F.
-template <int F, int P>
-ModalLti<Fixed<F>, P> scaled_modal(const ModalLti<double, P>& l, const ModalScales<P>& s) {
+// The double step's coefficients in scaled units, in Q(31-F).F, for the N
+// modes of the scales; padding modes of the step (j >= N, see Layout) get
+// zero coefficients and stay at zero.
+template <int F, int N, int P>
+ModalLti<Fixed<F>, P> scaled_modal(const ModalLti<double, P>& l, const ModalScales<N>& s) {
+  static_assert(N <= P, "more scaled modes than the step has");
   ModalLti<Fixed<F>, P> out;
   using V = Eigen::Matrix<double, P, 1>;
-  const V sq = s.q, sv = s.v;
-  auto put = [](Eigen::Matrix<Fixed<F>, P, 1>& dst, const V& src) { dst = src.template cast<Fixed<F>>(); };
+  V sq = V::Ones(), sv = V::Ones(), keep = V::Zero();
+  sq.template head<N>() = s.q;
+  sv.template head<N>() = s.v;
+  keep.template head<N>().setOnes();
+  auto put = [&keep](Eigen::Matrix<Fixed<F>, P, 1>& dst, const V& src) {
+    dst = src.cwiseProduct(keep).template cast<Fixed<F>>();
+  };
   put(out.p11, l.p11);
   put(out.p12, l.p12.cwiseProduct(sv).cwiseQuotient(sq));
   put(out.p21, l.p21.cwiseProduct(sq).cwiseQuotient(sv));
