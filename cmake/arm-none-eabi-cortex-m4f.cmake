@@ -5,10 +5,8 @@ set(VINES_MCU_BOARD mps2-an386)
 # The firmware core is a template on the scalar; the FPU is single precision.
 set(VINES_MCU_SCALAR float CACHE STRING "Scalar type of the firmware core on the MCU")
 # Agreement required with the host run of the same scene in the same scalar
-# (float). Measured on El Centro: the TMD (linear) agrees to 2.3e-5 (x_r),
-# 3.6e-6 (peak); the VI NES is chaotic, and last-bit differences between the
-# two builds (most likely newlib's vs glibc's maths functions; not traced)
-# grow to 0.9 % in E_e and one contact in 17, while the peak agrees to 1.3e-6.
+# (float). Measured on El Centro: the TMD (linear) agrees to 3.9e-6 (peak),
+# 3.0e-6 (E_e), 1.2e-6 (x_r, absolute).
 set(VINES_MCU_RTOL_tmd 1e-4 CACHE STRING "TMD scene: largest relative difference from the host run")
 set(VINES_MCU_COUNT_RTOL_tmd 0 CACHE STRING "TMD scene: largest relative difference in counts")
 # Float VI NES: the host (AVX2, other summation order) and the M4F round

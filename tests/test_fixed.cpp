@@ -64,7 +64,7 @@ FixedRun run_fixed(double amplification) {
     m.lti.step(zd, a[k - 1], a[k]);
     lq.step(zq, Q(a[k - 1] / pga), Q(a[k] / pga));
     double x_fixed = 0;
-    for (int j = 0; j < 10; ++j) x_fixed += m.top_row(j) * scales.q(j) * static_cast<double>(zq(j));
+    for (int j = 0; j < 10; ++j) x_fixed += m.rows.top(j) * scales.q(j) * static_cast<double>(zq(j));
     const double x_double = m.top_x(zd);
     r.peak_double = std::fmax(r.peak_double, std::fabs(x_double));
     r.peak_fixed = std::fmax(r.peak_fixed, std::fabs(x_fixed));

@@ -67,7 +67,7 @@ int main() {
     total_q += dq;
     total_d += dd;
     double xq = 0;
-    for (int j = 0; j < 10; ++j) xq += g_model.top_row(j) * scales.q(j) * static_cast<double>(zq(j));
+    for (int j = 0; j < 10; ++j) xq += g_model.rows.top(j) * scales.q(j) * static_cast<double>(zq(j));
     const double xd = g_model.top_x(zd);
     peak = std::fmax(peak, std::fabs(xd));
     max_err = std::fmax(max_err, std::fabs(xq - xd));

@@ -372,8 +372,9 @@ bool lyapunov_split(const LtiSpec<2 * P>& spec, const Eigen::Matrix<double, 2 * 
     x(j, j) = xs(0);
     x(j, P + j) = x(P + j, j) = xs(1);
     x(P + j, P + j) = xs(2);
-    const Eigen::Vector2d c = Eigen::Matrix2d(Eigen::Matrix2d{{xs(0), xs(1)}, {xs(1), xs(2)}}) *
-                              Eigen::Vector2d(spec.bg(j), spec.bg(P + j));
+    Eigen::Matrix2d xj;
+    xj << xs(0), xs(1), xs(1), xs(2);
+    const Eigen::Vector2d c = xj * Eigen::Vector2d(spec.bg(j), spec.bg(P + j));
     qlin(j, NX) = qlin(NX, j) = c(0);
     qlin(P + j, NX) = qlin(NX, P + j) = c(1);
   }

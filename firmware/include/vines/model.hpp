@@ -103,13 +103,12 @@ struct Model {
   // Instantaneous forms: energies and powers.
   FormT kinetic, strain, device_potential, damping_power, input_power;
 
-  // Floors from z: x = pos_map * (position coordinates), likewise v; the
-  // rows of the top floor and the device floor, contiguous.
-  Eigen::Matrix<S, N, kP> pos_map;
-  VecP top_row, floor_row, bound_row;
-  // Modal form: the same rows, and the E_e linear form, for the fused exact
-  // step (step_read); E_e by the Lyapunov split when every mode is damped,
+  // Floors from z: x = pos_map * (position coordinates), likewise v. rows:
+  // the rows of the top floor and the device floor (contiguous), the floor
+  // bound's, and (modal form) the E_e linear form of the fused exact step
+  // (step_read); E_e by the Lyapunov split when every mode is damped,
   // ee_boundary being its V(z) (see lyapunov_split).
+  Eigen::Matrix<S, N, kP> pos_map;
   ModalRows<S, kP> rows;
   bool ee_lyapunov = false;
   ModalForm<S, kP> ee_boundary;
@@ -126,17 +125,17 @@ struct Model {
   VecN floor_v(const Eigen::MatrixBase<Z>& z) const { return pos_map.lazyProduct(z.template tail<kP>()); }
   // Top floor and device floor (the hot path).
   template <typename Z>
-  S top_x(const Eigen::MatrixBase<Z>& z) const { return top_row.dot(z.template head<kP>()); }
+  S top_x(const Eigen::MatrixBase<Z>& z) const { return rows.top.dot(z.template head<kP>()); }
   template <typename Z>
-  S top_v(const Eigen::MatrixBase<Z>& z) const { return top_row.dot(z.template tail<kP>()); }
+  S top_v(const Eigen::MatrixBase<Z>& z) const { return rows.top.dot(z.template tail<kP>()); }
   template <typename Z>
-  S dev_x(const Eigen::MatrixBase<Z>& z) const { return floor_row.dot(z.template head<kP>()); }
+  S dev_x(const Eigen::MatrixBase<Z>& z) const { return rows.dev.dot(z.template head<kP>()); }
   template <typename Z>
-  S dev_v(const Eigen::MatrixBase<Z>& z) const { return floor_row.dot(z.template tail<kP>()); }
+  S dev_v(const Eigen::MatrixBase<Z>& z) const { return rows.dev.dot(z.template tail<kP>()); }
   // A cheap bound on the largest |floor displacement|: sum of |q_j| max_i |phi_ij|.
   template <typename Z>
   S floor_bound(const Eigen::MatrixBase<Z>& z) const {
-    return bound_row.dot(z.template head<kP>().cwiseAbs());
+    return rows.bound.dot(z.template head<kP>().cwiseAbs());
   }
 };
 
@@ -263,12 +262,9 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     md.pos_map.setZero();
     md.pos_map.template leftCols<N>() = mo.phi.template cast<S>();
   }
-  md.top_row = md.pos_map.row(N - 1).transpose();
-  md.floor_row = md.pos_map.row(md.floor).transpose();
-  md.bound_row = md.pos_map.cwiseAbs().colwise().maxCoeff().transpose();
-  md.rows.top = md.top_row;
-  md.rows.dev = md.floor_row;
-  md.rows.bound = md.bound_row;
+  md.rows.top = md.pos_map.row(N - 1).transpose();
+  md.rows.dev = md.pos_map.row(md.floor).transpose();
+  md.rows.bound = md.pos_map.cwiseAbs().colwise().maxCoeff().transpose();
   md.rows.dev_is_top = md.floor == N - 1;
   if constexpr (M::kModal) md.lti = discretise_modal<S, P>(spec, md.h);
   else md.lti = discretise_dense<S, NX>(spec, md.h);
