@@ -35,7 +35,7 @@ std::unique_ptr<Engine> built_engine(const Scene& scene, const SceneParams& p, S
 
 RunTotals run_once(Engine& eng, const std::vector<double>& a) {
   eng.init(a[0]);
-  for (std::size_t k = 1; k < a.size(); ++k) eng.step(a[k]);
+  eng.run(a.data() + 1, a.size() - 1);
   return eng.totals();
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -74,6 +75,9 @@ class Engine {
   virtual ModelInfo info() const = 0;
   virtual void init(double a0) = 0;
   virtual void step(double a1) = 0;
+  // step() for each of n samples in turn: one call for a whole record (the
+  // loop then runs inside the instance, with no call per sample).
+  virtual void run(const double* a, std::size_t n) = 0;
   virtual Snapshot snapshot() const = 0;
   virtual RunTotals totals() const = 0;
   virtual Probe probe() const = 0;

@@ -210,7 +210,7 @@ class Cache {
     p.loop.floor_peaks = false;
     std::unique_ptr<Engine> e = build(s, p);
     e->init(ex.samples[0]);
-    for (std::size_t k = 1; k < ex.samples.size(); ++k) e->step(ex.samples[k]);
+    e->run(ex.samples.data() + 1, ex.samples.size() - 1);
     return e->totals();
   }
 

@@ -154,6 +154,27 @@ TEST(Stress, ACaseIsWrittenAsASceneThatRunsTheSame) {
   EXPECT_EQ(j["contacts"].get<long long>(), eng->totals().count.contacts);
 }
 
+// Engine::run (a whole record in one call, as bench and sweep use) is the
+// sample-by-sample loop: the same totals to the bit.
+TEST(Stress, EngineRunIsTheStepLoop) {
+  const StressCase c = case_with_contacts(ContactLaw::kKuwabara);
+  const std::vector<double> a = case_samples(c, records());
+  auto stepped = make_engine(c.params, c.scalar), whole = make_engine(c.params, c.scalar);
+  ASSERT_TRUE(stepped->build(c.params).ok());
+  ASSERT_TRUE(whole->build(c.params).ok());
+  stepped->init(a[0]);
+  for (std::size_t k = 1; k < a.size(); ++k) stepped->step(a[k]);
+  whole->init(a[0]);
+  whole->run(a.data() + 1, a.size() - 1);
+  const RunTotals s = stepped->totals(), w = whole->totals();
+  EXPECT_GT(w.count.contacts, 0);
+  EXPECT_EQ(w.count.steps, static_cast<std::int64_t>(a.size() - 1));
+  EXPECT_EQ(w.peak_top, s.peak_top);
+  EXPECT_EQ(w.elastic_energy, s.elastic_energy);
+  EXPECT_EQ(w.count.substeps, s.count.substeps);
+  EXPECT_EQ(w.count.contacts, s.count.contacts);
+}
+
 // ---- sub-step cap ----
 
 // A uniform frame of n stories (100 t floors, f1 near 10/n Hz), a VI NES of
