@@ -19,6 +19,7 @@
 #include <Eigen/LU>
 
 #include "vines/numeric/expm.hpp"
+#include "vines/numeric/inline.hpp"
 
 namespace vines {
 
@@ -138,9 +139,16 @@ struct ModalForm {
   S aa = S(0);
   bool positions_only = false;  // only qq is nonzero (the strain energy)
 
-  S eval(const VecX& z, S ag) const {
+  // The form when it has positions only (q: the P position coordinates).
+  template <typename Q>
+  S eval_positions(const Eigen::MatrixBase<Q>& q) const {
+    return (q.array() * qq.array() * q.array()).sum();
+  }
+
+  template <typename Z>  // z: a 2P vector or a segment of one
+  S eval(const Eigen::MatrixBase<Z>& z, S ag) const {
     const auto q = z.template head<P>().array();
-    if (positions_only) return (q * qq.array() * q).sum();
+    if (positions_only) return eval_positions(z.template head<P>());
     const auto v = z.template tail<P>().array();
     return (q * (qq.array() * q + qv.array() * v + qa.array() * ag)).sum() +
            (v * (vv.array() * v + va.array() * ag)).sum() + aa * ag * ag;

@@ -7,6 +7,7 @@
 #include "vines/data.hpp"
 #include "vines/model.hpp"
 #include "vines/numeric/hermite.hpp"
+#include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
 
 namespace vines {
@@ -39,13 +40,10 @@ void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>
 
 // Peak of the top floor over an exact step from (x0, v0) at z0 to (x1, v1) at
 // z1: quintic Hermite with the accelerations at both ends (error ~h^6), for a
-// converged peak at any rate. Only steps that can beat the peak are refined.
+// converged peak at any rate.
 template <typename S, int N, typename Dev>
-void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z0,
+void refine_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z0,
                      const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1) {
-  using numeric::abs_of;
-  const S bound = numeric::max_of(abs_of(x0), abs_of(x1)) + S(0.5) * m.hs * (abs_of(v0) + abs_of(v1));
-  if (bound <= d.peak_top) return;
   const S acc0 = m.top_v(m.lti.derivative(z0, a0, S(0)));
   const S acc1 = m.top_v(m.lti.derivative(z1, a1, S(0)));
   const S p = numeric::quintic_abs_max(x0, v0, acc0, x1, v1, acc1, m.hs);
@@ -54,12 +52,20 @@ void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typena
     d.t_peak_top = d.time(m) + m.h;
   }
 }
+// Every exact step: only steps that can beat the peak (by a cheap bound from
+// both ends) are refined.
+template <typename S, int N, typename Dev>
+VINES_INLINE void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
+                                  const typename Model<S, N, Dev>::VecX& z0, const typename Model<S, N, Dev>::VecX& z1,
+                                  S a0, S a1, S x0, S v0, S x1, S v1) {
+  const S bound = numeric::max_of(std::fabs(x0), std::fabs(x1)) + S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
+  if (bound > d.peak_top) refine_top_peak(m, d, z0, z1, a0, a1, x0, v0, x1, v1);
+}
 
 // Peak of the top floor over a sub-step of length h (cubic Hermite).
 template <typename S, int N, typename Dev>
 void update_top_peak_cubic(Data<S, N, Dev>& d, S x0, S v0, S x1, S v1, S h, double t1) {
-  using numeric::abs_of;
-  const S bound = numeric::max_of(abs_of(x0), abs_of(x1)) + S(0.5) * h * (abs_of(v0) + abs_of(v1));
+  const S bound = numeric::max_of(std::fabs(x0), std::fabs(x1)) + S(0.5) * h * (std::fabs(v0) + std::fabs(v1));
   if (bound <= d.peak_top) return;
   const S p = std::fmax(numeric::Cubic<S>::make(x0, v0, x1, v1, h).max_value(),
                         numeric::Cubic<S>::make(-x0, -v0, -x1, -v1, h).max_value());

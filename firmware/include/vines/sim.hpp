@@ -17,6 +17,7 @@
 
 #include "vines/data.hpp"
 #include "vines/model.hpp"
+#include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
 #include "vines/substep.hpp"
@@ -91,32 +92,35 @@ namespace detail {
 // or a particle beyond a wall by more than its radius. The floors are first
 // bounded cheaply (bound: sum of |q_j| max_i |phi_ij|; vsum: the sum of the
 // velocity coordinates, non-finite if any is); only a bound beyond the limit
-// costs the floors themselves.
+// costs the floors themselves. frame_diverged is the check without the
+// particle: an exact step checks only that, its particle having passed
+// may_touch (strictly between the walls, finite position and speed).
 template <typename S, int N, typename Dev>
-bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound, S vsum, S xf, S s,
-              S sd) {
+VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
+                                 S vsum) {
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
   if (!std::isfinite(bound + vsum)) return true;  // bound >= 0: an infinity stays one
   if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     if (!(std::fabs(z(N)) <= limit)) return true;
   }
+  return false;
+}
+template <typename S, int N, typename Dev>
+bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
+  if (frame_diverged(m, z, m.floor_bound(z), z.template tail<Model<S, N, Dev>::kP>().sum())) return true;
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     const S r = s - xf, radius = static_cast<S>(m.dev.design.radius);
     if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(sd)) return true;
   }
   return false;
 }
-template <typename S, int N, typename Dev>
-bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
-  return diverged(m, z, m.floor_bound(z), z.template tail<Model<S, N, Dev>::kP>().sum(), xf, s, sd);
-}
 
 // The exact step of the linear part from d.z to z1 with its readouts: the
 // modal form fuses them into the step (step_read); the dense form (TMD)
 // reads them off z1.
 template <typename S, int N, typename Dev>
-StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, typename Model<S, N, Dev>::VecX& z1,
+VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, typename Model<S, N, Dev>::VecX& z1,
                         S a0, S a1) {
   if constexpr (Model<S, N, Dev>::kModal) {
     return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, d.z, z1, a0, a1);
@@ -133,7 +137,7 @@ StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, typ
 // split, a run of exact steps opens with V(z) added (E_e is then
 // ee_sum - V(z_now)) and each step adds its linear form.
 template <typename S, int N, typename Dev>
-void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0, S a1) {
+VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0, S a1) {
   if (m.ee_lyapunov) {
     if (!d.ee_open) {
       d.ee_sum += static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
@@ -156,7 +160,7 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
 // Commits an exact step to z1 (readouts r; particle at s1, s1'), with its
 // step integrals.
 template <typename S, int N, typename Dev>
-void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1,
+VINES_INLINE void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1,
                   const StepRead<S>& r, S a0, S a1, S s1, S sd1) {
   add_elastic_step(m, d, r, a0, a1);
   if (m.loop.energy_ledger) {
@@ -182,7 +186,7 @@ void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename 
 // relative position may reach a wall (cubic through both ends of the free
 // step, with a margin for what a cubic misses).
 template <typename S, int N, typename Dev>
-bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1, S xf1, S vf1) {
+VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1, S xf1, S vf1) {
   const auto& dm = m.dev;
   const S h = m.hs;
   const S r0 = d.s - d.xf, rd0 = d.sd - d.vf;
@@ -190,8 +194,7 @@ bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1,
   // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
   // bounded by its end values plus what the cubic allows between them.
   const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
-  using numeric::abs_of;
-  const S reach = h * (numeric::max_of(abs_of(rd0), abs_of(rd1)) + abs_of(rd1 - rd0)) + tiny;
+  const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + tiny;
   const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
   if (lo > dm.wall_left && hi < dm.wall_right) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + tiny;
@@ -208,7 +211,7 @@ bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1,
 // model holds its last good state, the clock advances) and counted. Both
 // counters are outputs; neither stops the loop.
 template <typename S, int N, typename Dev>
-void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
+VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   using VecX = typename Model<S, N, Dev>::VecX;
   if (!std::isfinite(a1)) {
     ++d.count.bad_samples;
@@ -229,7 +232,7 @@ void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
     }
     // 2a. Commit the exact step, unless it diverged.
     if (!careful) {
-      if (detail::diverged(m, z1, r.bound, r.vsum, r.xf, s1, sd1)) ++d.count.divergences;
+      if (detail::frame_diverged(m, z1, r.bound, r.vsum)) ++d.count.divergences;
       else detail::commit_exact(m, d, z1, r, a0, a1, s1, sd1);
     }
   }

@@ -51,16 +51,17 @@ struct Cubic {
     return best;
   }
   // First theta in (0, 1] where the cubic rises through zero, given
-  // value(0) <= 0: bracketing on a fine grid, then bisection. Returns 1 if
-  // none is found (the caller re-checks with the true solution).
-  S first_upcrossing() const {
+  // value(0) <= 0: bracketing on a fine grid, then `halvings` bisections
+  // (60: to rounding; a caller that refines the root itself needs fewer).
+  // Returns 1 if none is found (the caller re-checks with the true solution).
+  S first_upcrossing(int halvings = 60) const {
     constexpr int kGrid = 16;
     S lo = S(0), flo = y0;
     for (int i = 1; i <= kGrid; ++i) {
       const S hi = S(i) / S(kGrid), fhi = value(hi);
       if (fhi > S(0) && flo <= S(0)) {
         S a = lo, b = hi;
-        for (int it = 0; it < 60; ++it) {
+        for (int it = 0; it < halvings; ++it) {
           const S m = S(0.5) * (a + b);
           if (value(m) > S(0)) b = m; else a = m;
         }
