@@ -4,13 +4,13 @@
 // mode obeys  q'' + 2 zeta w q' + w^2 q = -gamma a_g(t) + phi_top F(t);
 // a_g and F are both taken linear over a step (first-order hold, like the core
 // loop's ground acceleration), so every mode is stepped exactly by a 2x2
-// transition and two input columns, computed once from a 4x4 exponential.
+// transition and two input columns (lti.hpp's first-order-hold step).
 // No heap; n <= kMaxStories at run time.
 #pragma once
 
 #include <Eigen/Core>
 
-#include "vines/numeric/expm.hpp"
+#include "vines/lti.hpp"
 #include "vines/params.hpp"
 
 namespace vines::link {
@@ -30,17 +30,14 @@ class HybridFrame {
     h_ = h;
     for (int j = 0; j < md.n; ++j) {
       const double w = md.omega[j], z = md.zeta[j];
-      Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
-      a(0, 1) = 1;
-      a(1, 0) = -w * w;
-      a(1, 1) = -2 * z * w;
-      a(1, 2) = 1;  // modal input u
-      a(2, 3) = 1;  // u' (constant over the step)
-      const Eigen::Matrix4d e = numeric::expm<Eigen::Matrix4d>(a * h);
+      Eigen::Matrix2d a;
+      a << 0, 1, -w * w, -2 * z * w;
+      // The core loop's exact FOH step, with the modal input u as the input.
+      const vines::detail::Foh<2> f = vines::detail::foh<2>(a, Eigen::Vector2d(0, 1), h);
       for (int r = 0; r < 2; ++r) {
-        for (int c = 0; c < 2; ++c) phi_t_[j][r][c] = static_cast<S>(e(r, c));
-        g0_[j][r] = static_cast<S>(e(r, 2) - e(r, 3) / h);  // u(t) = u0 + (u1 - u0) t / h
-        g1_[j][r] = static_cast<S>(e(r, 3) / h);
+        for (int c = 0; c < 2; ++c) phi_t_[j][r][c] = static_cast<S>(f.phi(r, c));
+        g0_[j][r] = static_cast<S>(f.g0(r));
+        g1_[j][r] = static_cast<S>(f.g1(r));
       }
     }
   }
