@@ -147,8 +147,8 @@ struct ModalForm {
 
   template <typename Z>  // z: a 2P vector or a segment of one
   S eval(const Eigen::MatrixBase<Z>& z, S ag) const {
-    const auto q = z.template head<P>().array();
     if (positions_only) return eval_positions(z.template head<P>());
+    const auto q = z.template head<P>().array();
     const auto v = z.template tail<P>().array();
     return (q * (qq.array() * q + qv.array() * v + qa.array() * ag)).sum() +
            (v * (vv.array() * v + va.array() * ag)).sum() + aa * ag * ag;

@@ -120,8 +120,8 @@ bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& 
 // modal form fuses them into the step (step_read); the dense form (TMD)
 // reads them off z1.
 template <typename S, int N, typename Dev>
-VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, typename Model<S, N, Dev>::VecX& z1,
-                        S a0, S a1) {
+VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d,
+                                     typename Model<S, N, Dev>::VecX& z1, S a0, S a1) {
   if constexpr (Model<S, N, Dev>::kModal) {
     return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, d.z, z1, a0, a1);
   } else {
@@ -137,7 +137,8 @@ VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N,
 // split, a run of exact steps opens with V(z) added (E_e is then
 // ee_sum - V(z_now)) and each step adds its linear form.
 template <typename S, int N, typename Dev>
-VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0, S a1) {
+VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0,
+                                   S a1) {
   if (m.ee_lyapunov) {
     if (!d.ee_open) {
       d.ee_sum += static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
@@ -160,8 +161,9 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
 // Commits an exact step to z1 (readouts r; particle at s1, s1'), with its
 // step integrals.
 template <typename S, int N, typename Dev>
-VINES_INLINE void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1,
-                  const StepRead<S>& r, S a0, S a1, S s1, S sd1) {
+VINES_INLINE void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
+                               const typename Model<S, N, Dev>::VecX& z1, const StepRead<S>& r, S a0, S a1, S s1,
+                               S sd1) {
   add_elastic_step(m, d, r, a0, a1);
   if (m.loop.energy_ledger) {
     d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));

@@ -24,6 +24,7 @@
 #include "vines/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
+#include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
 
@@ -108,28 +109,31 @@ struct SubStepper {
   S rel_pos(const Vec& y) const { return y(NX) - m.dev_x(y.template head<NX>()); }
   S rel_vel(const Vec& y) const { return y(NX + 1) - m.dev_v(y.template head<NX>()); }
 
-  // Force on the particle (positive to the right) and the power lost in it.
   // Overlap rate d' of the current contact.
   S overlap_rate(const Vec& y) const { return mode == Mode::kContactLeft ? -rel_vel(y) : rel_vel(y); }
 
-  void force(const Vec& y, S* fp, S* loss) const {
+  // Force on the particle (positive to the right) and the power lost in it;
+  // *rate, if asked for: the overlap rate d' in a contact, 0 otherwise.
+  VINES_INLINE void force(const Vec& y, S* fp, S* loss, S* rate = nullptr) const {
     *fp = S(0);
     *loss = S(0);
+    if (rate) *rate = S(0);
     const auto& dm = m.dev;
-    const S t = y(kT);
     if (regular()) {
       if constexpr (Dev::kLaw != ContactLaw::kRestitution) {
         const S ddl = overlap_rate(y);
         const contact::Force<S> f = dm.law.regular(y(kQ), ddl);
         *fp = mode == Mode::kContactLeft ? f.total() : -f.total();
         *loss = f.dissipative * ddl;
+        if (rate) *rate = ddl;
       }
     } else if (mode == Mode::kStuckLeft || mode == Mode::kStuckRight) {
       // Riding the wall: the force that gives the particle the floor's
       // acceleration, m* (floor acceleration without the device + a_g).
+      const S a = ag(y(kT));
       const VecX z = y.template head<NX>();
-      const S floor_acc = m.dev_v(m.lti.derivative(z, ag(t), S(0)));
-      *fp = dm.m_star * (floor_acc + ag(t));
+      const S floor_acc = m.dev_v(m.lti.derivative(z, a, S(0)));
+      *fp = dm.m_star * (floor_acc + a);
     }
   }
 
@@ -140,19 +144,9 @@ struct SubStepper {
     const auto& l = m.lti;
     const auto& dm = m.dev;
     const S a = ag(y(kT));
-    S fp = S(0), loss = S(0), w = S(1), dq = S(0);
-    if (regular()) {
-      if constexpr (Dev::kLaw != ContactLaw::kRestitution) {
-        const S q = y(kQ);
-        dq = overlap_rate(y);
-        const contact::Force<S> f = dm.law.regular(q, dq);
-        fp = mode == Mode::kContactLeft ? f.total() : -f.total();
-        loss = f.dissipative * dq;
-        w = S(4) * q * q * q;
-      }
-    } else if (mode != Mode::kFree) {
-      force(y, &fp, &loss);
-    }
+    S fp, loss, dq;
+    force(y, &fp, &loss, &dq);
+    const S w = regular() ? S(4) * y(kQ) * y(kQ) * y(kQ) : S(1);
     const auto q = y.template head<P>().array();
     const auto v = y.template segment<P>(P).array();
     Vec dy;
@@ -169,9 +163,8 @@ struct SubStepper {
     } else {
       dy(NX + 3) = dy(NX + 4) = S(0);
     }
-    const S strain = m.strain.positions_only ? m.strain.eval_positions(y.template head<P>())
-                                             : m.strain.eval(y.template head<NX>(), a);
-    dy(NX + 5) = w * strain;
+    // The strain energy is a form in the positions alone (w_j^2 q_j^2 / 2).
+    dy(NX + 5) = w * m.strain.eval_positions(y.template head<P>());
     dy(kT) = w;
     dy(kQ) = dq;
     return dy;
