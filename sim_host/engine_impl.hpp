@@ -37,11 +37,7 @@ class EngineImpl final : public Engine {
 
   void init(double a0) override { vines::init(*model_, *data_, static_cast<S>(a0)); }
   void step(double a1) override { vines::step(*model_, *data_, static_cast<S>(a1)); }
-  void run(const double* a, std::size_t n) override {
-    const Model<S, N, Dev>& m = *model_;
-    Data<S, N, Dev>& d = *data_;
-    for (std::size_t k = 0; k < n; ++k) vines::step(m, d, static_cast<S>(a[k]));
-  }
+  void run(const double* a, std::size_t n) override { vines::run(*model_, *data_, a, n); }
 
   Snapshot snapshot() const override {
     const Model<S, N, Dev>& m = *model_;

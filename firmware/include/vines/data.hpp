@@ -48,19 +48,27 @@ struct Counters {
   std::int64_t divergences = 0;   // steps rolled back by the divergence guard
 };
 
+// The scalars a step carries to the next besides the linear state: the VI
+// NES particle and the floors it moves against. A run of free steps keeps
+// them in registers (run_exact() in sim.hpp).
+template <typename S>
+struct Carry {
+  // VI NES particle: s = displacement from its start (relative to ground).
+  S s = S(0), sd = S(0);
+  // The top floor and the device floor now.
+  S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
+};
+
 template <typename S, int N, typename Dev>
-struct Data {
+struct Data : Carry<S> {
   using M = Model<S, N, Dev>;
   using VecX = typename M::VecX;
   using VecN = typename M::VecN;
 
-  std::int64_t k = 0;  // samples consumed; the state is at t = k h
-  S a_prev = S(0);     // ground acceleration at the current time
-  VecX z = VecX::Zero();  // linear part
-
-  // VI NES particle: s = displacement from its start (relative to ground).
-  S s = S(0), sd = S(0);
-  Mode mode = Mode::kFree;
+  VecX z = VecX::Zero();    // linear part
+  S a_prev = S(0);          // ground acceleration at the current time
+  std::int64_t k = 0;       // samples consumed; the state is at t = k h
+  Mode mode = Mode::kFree;  // VI NES
   S substep = S(0);         // last sub-step size in t (carried across steps)
   S substep_w = S(0);       // last sub-step size in w inside a contact
   S q = S(0);               // overlap^{1/4} of the current contact
@@ -68,8 +76,6 @@ struct Data {
   S contact_depth = S(0);   // deepest overlap of the current contact
   S max_overlap = S(0);     // deepest overlap of the run
 
-  // The top floor and the device floor now (kept: every step needs them).
-  S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
   // Running maxima over the whole run (continuous in time, not just samples);
   // per floor only with loop.floor_peaks.
   VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();

@@ -67,12 +67,15 @@ struct ModalLti {
 
 // What the loop reads off every exact step, taken in the same pass over the
 // modes as the step itself: the top floor and the device floor after it, a
-// cheap bound on every floor (sum of |q_j| max_i |phi_ij|), the sum of the
-// modal velocities (non-finite if any is), and a linear form of the state
-// before the step in (a0, a1) (the E_e step integral, see build_model).
+// cheap bound on every floor (sum of |q_j| max_i |phi_ij|, non-finite if any
+// position is), a probe non-finite if any velocity is, and a linear form of
+// the state before the step in (a0, a1) (the E_e step integral, see
+// build_model). The modal probe is vt itself: a sum over every mode with
+// finite weights, so an infinity or NaN in any mode reaches it (0 * inf is
+// NaN).
 template <typename S>
 struct StepRead {
-  S xt, vt, xf, vf, bound, vsum, lin;
+  S xt, vt, xf, vf, bound, vprobe, lin;
 };
 
 template <typename S, int P>
@@ -87,7 +90,7 @@ struct ModalRows {
 
 // Exact step of z0 to z1 with its readouts (WithDev: a device floor is read).
 template <bool WithDev, typename S, int P>
-StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw, const Eigen::Matrix<S, 2 * P, 1>& z0,
+VINES_INLINE StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw, const Eigen::Matrix<S, 2 * P, 1>& z0,
                       Eigen::Matrix<S, 2 * P, 1>& z1, S a0, S a1) {
   using Arr = Eigen::Array<S, P, 1>;
   const auto q = z0.template head<P>().array();
@@ -106,7 +109,7 @@ StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw, const 
     r.vf = (rw.dev.array() * v1).sum();
   }
   r.bound = (rw.bound.array() * q1.abs()).sum();
-  r.vsum = v1.sum();
+  r.vprobe = r.vt;
   z1.template head<P>() = q1.matrix();
   z1.template tail<P>() = v1.matrix();
   return r;

@@ -112,6 +112,10 @@ struct Model {
   ModalRows<S, kP> rows;
   bool ee_lyapunov = false;
   ModalForm<S, kP> ee_boundary;
+  // The top floor's acceleration relative to the ground with no device
+  // force: top_acc_z . z + top_acc_ag a_g (a row of the linear part).
+  VecX top_acc_z = VecX::Zero();
+  S top_acc_ag = S(0);
   // Absolute floor acceleration: -(M^-1 K) x - (M^-1 C) v + (force on floor f) / m_f.
   Eigen::Matrix<S, N, N> minv_k, minv_c;
   S inv_floor_mass = S(0);
@@ -128,6 +132,8 @@ struct Model {
   S top_x(const Eigen::MatrixBase<Z>& z) const { return rows.top.dot(z.template head<kP>()); }
   template <typename Z>
   S top_v(const Eigen::MatrixBase<Z>& z) const { return rows.top.dot(z.template tail<kP>()); }
+  template <typename Z>
+  S top_a(const Eigen::MatrixBase<Z>& z, S ag) const { return top_acc_z.dot(z) + top_acc_ag * ag; }
   template <typename Z>
   S dev_x(const Eigen::MatrixBase<Z>& z) const { return rows.dev.dot(z.template head<kP>()); }
   template <typename Z>
@@ -268,6 +274,8 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   md.rows.dev_is_top = md.floor == N - 1;
   if constexpr (M::kModal) md.lti = discretise_modal<S, P>(spec, md.h);
   else md.lti = discretise_dense<S, NX>(spec, md.h);
+  md.top_acc_z = pv.row(N - 1).lazyProduct(spec.a).transpose().template cast<S>();
+  md.top_acc_ag = static_cast<S>(pv.row(N - 1).dot(spec.bg));
 
   // Energies and powers as quadratic forms in [z; a_g].
   using QX = Eigen::Matrix<double, NX, NX>;
@@ -277,7 +285,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   const auto q_damp = detail::zz_form<NX>(QX(pv.transpose() * ph.c * pv));
   // Input power -a_g (sum of m v) as a bilinear form: off-diagonal halves.
   Eigen::Matrix<double, NX + 1, NX + 1> q_in = Eigen::Matrix<double, NX + 1, NX + 1>::Zero();
-  const Eigen::Matrix<double, NX, 1> mv = pv.transpose() * ph.m.diagonal();
+  const Eigen::Matrix<double, NX, 1> mv = pv.transpose().lazyProduct(ph.m.diagonal());
   q_in.template block<NX, 1>(0, NX) = -0.5 * mv;
   q_in.template block<1, NX>(NX, 0) = -0.5 * mv.transpose();
 

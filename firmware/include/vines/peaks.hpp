@@ -38,28 +38,18 @@ void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>
   }
 }
 
-// Peak of the top floor over an exact step from (x0, v0) at z0 to (x1, v1) at
-// z1: quintic Hermite with the accelerations at both ends (error ~h^6), for a
-// converged peak at any rate.
+// Peak of |top floor| over an exact step from (x0, v0) at z0 to (x1, v1) at
+// z1 when the step can beat the running peak (by a cheap bound from both
+// ends), else 0: quintic Hermite with the accelerations at both ends (error
+// ~h^6), for a converged peak at any rate. All but the quintic is inline and
+// takes no address of a state: the caller's state may stay in registers.
 template <typename S, int N, typename Dev>
-void refine_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z0,
-                     const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1) {
-  const S acc0 = m.top_v(m.lti.derivative(z0, a0, S(0)));
-  const S acc1 = m.top_v(m.lti.derivative(z1, a1, S(0)));
-  const S p = numeric::quintic_abs_max(x0, v0, acc0, x1, v1, acc1, m.hs);
-  if (p > d.peak_top) {
-    d.peak_top = p;
-    d.t_peak_top = d.time(m) + m.h;
-  }
-}
-// Every exact step: only steps that can beat the peak (by a cheap bound from
-// both ends) are refined.
-template <typename S, int N, typename Dev>
-VINES_INLINE void update_top_peak(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
-                                  const typename Model<S, N, Dev>::VecX& z0, const typename Model<S, N, Dev>::VecX& z1,
-                                  S a0, S a1, S x0, S v0, S x1, S v1) {
+VINES_INLINE S top_peak_of_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
+                                const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1,
+                                S peak) {
   const S bound = numeric::max_of(std::fabs(x0), std::fabs(x1)) + S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
-  if (bound > d.peak_top) refine_top_peak(m, d, z0, z1, a0, a1, x0, v0, x1, v1);
+  if (!VINES_UNLIKELY(bound > peak)) return S(0);
+  return numeric::quintic_abs_max(x0, v0, m.top_a(z0, a0), x1, v1, m.top_a(z1, a1), m.hs);
 }
 
 // Peak of the top floor over a sub-step of length h (cubic Hermite).

@@ -10,10 +10,13 @@
 //      starts and ends located to rounding, capped per step (cap hits are
 //      counted);
 //   3. guards (non-finite input held, diverging steps rolled back), counters.
-// Work per step is bounded; no heap, no exceptions.
+// Work per step is bounded; no heap, no exceptions. run() feeds a block of
+// samples: the same steps, with each run of plain exact steps done on a
+// local copy of the step state that stays in registers.
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 
 #include "vines/data.hpp"
 #include "vines/model.hpp"
@@ -90,17 +93,21 @@ namespace detail {
 // Divergence check (MuJoCo-style warning) on a state z (with the particle at
 // s, s'): anything non-finite, a floor or the TMD beyond the model's limit,
 // or a particle beyond a wall by more than its radius. The floors are first
-// bounded cheaply (bound: sum of |q_j| max_i |phi_ij|; vsum: the sum of the
-// velocity coordinates, non-finite if any is); only a bound beyond the limit
+// bounded cheaply (bound: sum of |q_j| max_i |phi_ij|; vprobe: non-finite if
+// any velocity coordinate is, see StepRead); only a bound beyond the limit
 // costs the floors themselves. frame_diverged is the check without the
 // particle: an exact step checks only that, its particle having passed
 // may_touch (strictly between the walls, finite position and speed).
 template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
-                                 S vsum) {
+                                 S vprobe) {
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
-  if (!std::isfinite(bound + vsum)) return true;  // bound >= 0: an infinity stays one
-  if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
+  if (VINES_UNLIKELY(!std::isfinite(bound + vprobe))) return true;  // bound >= 0: an infinity stays one
+  if (VINES_UNLIKELY(bound > limit)) {  // floor by floor (no temporary holding z's address)
+    for (int i = 0; i < N; ++i) {
+      if (!(std::fabs(m.pos_map.row(i).dot(z.template head<Model<S, N, Dev>::kP>())) <= limit)) return true;
+    }
+  }
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     if (!(std::fabs(z(N)) <= limit)) return true;
   }
@@ -116,16 +123,16 @@ bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& 
   return false;
 }
 
-// The exact step of the linear part from d.z to z1 with its readouts: the
+// The exact step of the linear part from z0 to z1 with its readouts: the
 // modal form fuses them into the step (step_read); the dense form (TMD)
 // reads them off z1.
 template <typename S, int N, typename Dev>
-VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d,
+VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                      typename Model<S, N, Dev>::VecX& z1, S a0, S a1) {
   if constexpr (Model<S, N, Dev>::kModal) {
-    return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, d.z, z1, a0, a1);
+    return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, z0, z1, a0, a1);
   } else {
-    z1 = d.z;
+    z1 = z0;
     m.lti.step(z1, a0, a1);
     const S xt = m.top_x(z1), vt = m.top_v(z1);
     return {xt, vt, m.dev_x(z1), m.dev_v(z1), m.floor_bound(z1),
@@ -133,20 +140,40 @@ VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const Data<S, N,
   }
 }
 
-// E_e over the exact step from d.z (r: its readouts). With the Lyapunov
-// split, a run of exact steps opens with V(z) added (E_e is then
-// ee_sum - V(z_now)) and each step adds its linear form.
+// The exact steps of the linear part from z0 through the samples as[0..n]
+// (as[0]: the sample at z0): zs[i], rs[i] after step i. One compiled loop
+// that step() (n = 1) and run_exact() (a block) both call, out of line on
+// purpose: inlined into each caller, the compiler would contract a * b + c
+// into fma differently in each, and the loop image and the host would differ
+// in the last bits.
 template <typename S, int N, typename Dev>
-VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const StepRead<S>& r, S a0,
-                                   S a1) {
+VINES_NOINLINE void linear_steps(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
+                                 typename Model<S, N, Dev>::VecX* zs, StepRead<S>* rs, const S* as, int n) {
+  typename Model<S, N, Dev>::VecX z = z0;
+  for (int i = 0; i < n; ++i) {
+    rs[i] = linear_step(m, z, zs[i], as[i], as[i + 1]);
+    z = zs[i];
+  }
+}
+
+// E_e over the exact step from z (r: its readouts). With the Lyapunov
+// split, a run of exact steps opens with V(z) added (E_e is then
+// ee_sum - V(z_now)) and each step adds its linear form. The forms are
+// evaluated on a copy of z: its address is not taken, and run_exact's motion
+// may stay in registers.
+template <typename S, int N, typename Dev>
+VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
+                                   const typename Model<S, N, Dev>::VecX& z, const StepRead<S>& r, S a0, S a1) {
   if (m.ee_lyapunov) {
-    if (!d.ee_open) {
-      d.ee_sum += static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
+    if (VINES_UNLIKELY(!d.ee_open)) {
+      const typename Model<S, N, Dev>::VecX z0 = z;
+      d.ee_sum += static_cast<double>(m.ee_boundary.eval(z0, S(0)));
       d.ee_open = true;
     }
     d.ee_sum += static_cast<double>(r.lin);
   } else {
-    d.ee_sum += static_cast<double>(m.strain_step.eval(d.z, a0, a1));
+    const typename Model<S, N, Dev>::VecX z0 = z;
+    d.ee_sum += static_cast<double>(m.strain_step.eval(z0, a0, a1));
   }
 }
 
@@ -158,37 +185,11 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   d.ee_open = false;
 }
 
-// Commits an exact step to z1 (readouts r; particle at s1, s1'), with its
-// step integrals.
-template <typename S, int N, typename Dev>
-VINES_INLINE void commit_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
-                               const typename Model<S, N, Dev>::VecX& z1, const StepRead<S>& r, S a0, S a1, S s1,
-                               S sd1) {
-  add_elastic_step(m, d, r, a0, a1);
-  if (m.loop.energy_ledger) {
-    d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
-    d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
-    if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, d.sd, a0, a1);
-  }
-  if (m.loop.floor_peaks)
-    update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.hs, d.peak_x, d.peak_drift);
-  update_top_peak(m, d, d.z, z1, a0, a1, d.xt, d.vt, r.xt, r.vt);
-  d.z = z1;
-  d.xt = r.xt;
-  d.vt = r.vt;
-  if constexpr (Dev::kKind == DeviceKind::kVines) {
-    d.s = s1;
-    d.sd = sd1;
-    d.xf = r.xf;
-    d.vf = r.vf;
-  }
-}
-
 // The particle may touch a wall within the step: it is in contact, or its
 // relative position may reach a wall (cubic through both ends of the free
 // step, with a margin for what a cubic misses).
 template <typename S, int N, typename Dev>
-VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d, S s1, S sd1, S xf1, S vf1) {
+VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Carry<S>& d, S s1, S sd1, S xf1, S vf1) {
   const auto& dm = m.dev;
   const S h = m.hs;
   const S r0 = d.s - d.xf, rd0 = d.sd - d.vf;
@@ -198,11 +199,58 @@ VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d,
   const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
   const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + tiny;
   const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
-  if (lo > dm.wall_left && hi < dm.wall_right) return false;
+  if (!VINES_UNLIKELY(!(lo > dm.wall_left && hi < dm.wall_right))) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + tiny;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
   const auto right = numeric::Cubic<S>::make(r0 - dm.wall_right, rd0, r1 - dm.wall_right, rd1, h);
   return left.max_value() + margin > S(0) || right.max_value() + margin > S(0);
+}
+
+// What became of an exact step.
+enum class Exact : unsigned char { kDone, kCareful, kDiverged };
+
+// Finishes the exact step of the linear part from z0 to z1 (readouts r),
+// from a0 to a1: the particle flies, and the step is committed with its step
+// integrals (kDone), unless the VI NES particle may touch a wall during it
+// (kCareful) or the frame diverged (kDiverged), which change nothing. c is
+// what the step carries (d itself in step(), a copy in registers in
+// run_exact()); the caller commits z1. extras(z1) runs just before the
+// commit (at the step's start): the energy ledger and per-floor peaks, when
+// kept.
+template <typename S, int N, typename Dev, typename Extras>
+VINES_INLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, Data<S, N, Dev>& d,
+                                const typename Model<S, N, Dev>::VecX& z0, const typename Model<S, N, Dev>::VecX& z1,
+                                const StepRead<S>& r, S a0, S a1, Extras&& extras) {
+  S s1 = S(0), sd1 = S(0);  // the particle (VI NES)
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    free_flight(m, c.s, c.sd, a0, a1, &s1, &sd1);
+    if (may_touch(m, c, s1, sd1, r.xf, r.vf)) return Exact::kCareful;
+  }
+  if (VINES_UNLIKELY(frame_diverged(m, z1, r.bound, r.vprobe))) return Exact::kDiverged;
+  add_elastic_step(m, d, z0, r, a0, a1);
+  extras(z1);
+  const S peak = top_peak_of_step(m, z0, z1, a0, a1, c.xt, c.vt, r.xt, r.vt, d.peak_top);
+  if (VINES_UNLIKELY(peak > d.peak_top)) {
+    d.peak_top = peak;
+    d.t_peak_top = d.time(m) + m.h;
+  }
+  c.xt = r.xt;
+  c.vt = r.vt;
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    c.s = s1;
+    c.sd = sd1;
+    c.xf = r.xf;
+    c.vf = r.vf;
+  }
+  return Exact::kDone;
+}
+
+// The clock and what is read at every sample, after a step (top floor now
+// at velocity vt).
+template <typename S, int N, typename Dev>
+VINES_INLINE void end_step(Data<S, N, Dev>& d, S vt) {
+  if (std::fabs(vt) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(vt);
+  ++d.k;
 }
 
 }  // namespace detail
@@ -221,22 +269,27 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   }
   const S a0 = d.a_prev;
 
-  // 1. Exact step into temporaries.
+  // 1.-2a. Exact step, committed unless it needs care or diverged.
   bool careful = false;
   if constexpr (Dev::kKind == DeviceKind::kVines) careful = d.mode != Mode::kFree;
   if (!careful) {
     VecX z1;
-    const StepRead<S> r = detail::linear_step(m, d, z1, a0, a1);
-    S s1 = S(0), sd1 = S(0);  // the particle (VI NES)
-    if constexpr (Dev::kKind == DeviceKind::kVines) {
-      free_flight(m, d.s, d.sd, a0, a1, &s1, &sd1);
-      careful = detail::may_touch(m, d, s1, sd1, r.xf, r.vf);
-    }
-    // 2a. Commit the exact step, unless it diverged.
-    if (!careful) {
-      if (detail::frame_diverged(m, z1, r.bound, r.vsum)) ++d.count.divergences;
-      else detail::commit_exact(m, d, z1, r, a0, a1, s1, sd1);
-    }
+    StepRead<S> r;
+    const S as[2] = {a0, a1};
+    detail::linear_steps(m, d.z, &z1, &r, as, 1);
+    const detail::Exact e = detail::finish_exact(m, d, d, d.z, z1, r, a0, a1, [&m, &d, a0, a1](const VecX& z) {
+      if (m.loop.energy_ledger) {
+        d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
+        d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
+        if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, d.sd, a0, a1);
+      }
+      if (m.loop.floor_peaks)
+        detail::update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z), m.floor_v(z), m.hs, d.peak_x,
+                                   d.peak_drift);
+    });
+    if (e == detail::Exact::kDone) d.z = z1;
+    careful = e == detail::Exact::kCareful;
+    if (e == detail::Exact::kDiverged) ++d.count.divergences;
   }
 
   if constexpr (Dev::kKind == DeviceKind::kVines) {
@@ -257,16 +310,81 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   }
 
   // 3. Bookkeeping.
-  if (std::fabs(d.vt) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(d.vt);
-  ++d.k;
-  ++d.count.steps;
+  detail::end_step(d, d.vt);
   d.a_prev = a1;
+  ++d.count.steps;
   if (m.loop.floor_peaks) {
     const double strain_now = static_cast<double>(m.strain.eval(d.z, S(0)));
     if (strain_now > d.last_strain) d.strain_increments += strain_now - d.last_strain;
     d.last_strain = strain_now;
   }
   if (m.loop.energy_ledger) detail::close_ledger(m, d);
+}
+
+namespace detail {
+
+// Plain exact steps from a[0] on, as many as follow one another (the VI NES
+// particle free and clear of the walls, finite samples, no energy ledger or
+// per-floor peaks to keep), with step()'s arithmetic, block by block: first
+// the frame through the block (it does not depend on the particle while the
+// particle flies free), then the particle, guards, peaks and E_e step by
+// step, with what they carry in registers, up to the first step that is not
+// a plain exact step. Blocks grow from one step, so a run that ends at once
+// wastes little frame work. Returns the samples consumed.
+template <typename S, int N, typename Dev, typename T>
+std::size_t run_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a, std::size_t n) {
+  using VecX = typename Model<S, N, Dev>::VecX;
+  constexpr int kMax = 32;  // largest block
+  if (m.loop.energy_ledger || m.loop.floor_peaks) return 0;
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    if (d.mode != Mode::kFree) return 0;
+  }
+  VecX zs[kMax];  // the frame after each step of the block
+  StepRead<S> rs[kMax];
+  S as[kMax + 1];  // the block's samples, after the one before it
+  std::size_t done = 0;
+  for (int block = 1; done < n; block = block < kMax ? 2 * block : kMax) {
+    const int nb = n - done < static_cast<std::size_t>(block) ? static_cast<int>(n - done) : block;
+    // 1. The frame, over the block's finite samples.
+    as[0] = d.a_prev;
+    int nf = 0;
+    for (; nf < nb; ++nf) {
+      const S a1 = static_cast<S>(a[done + static_cast<std::size_t>(nf)]);
+      if (VINES_UNLIKELY(!std::isfinite(a1))) break;
+      as[nf + 1] = a1;
+    }
+    linear_steps(m, d.z, zs, rs, as, nf);
+    // 2. The rest, step by step.
+    Carry<S> c = d;
+    int j = 0;
+    for (; j < nf; ++j) {
+      const VecX& z0 = j ? zs[j - 1] : d.z;
+      if (finish_exact(m, c, d, z0, zs[j], rs[j], as[j], as[j + 1], [](const VecX&) {}) != Exact::kDone) break;
+      end_step(d, c.vt);
+    }
+    static_cast<Carry<S>&>(d) = c;
+    if (j > 0) {
+      d.z = zs[j - 1];
+      d.a_prev = as[j];
+    }
+    d.count.steps += j;
+    done += static_cast<std::size_t>(j);
+    if (j < nb) break;
+  }
+  return done;
+}
+
+}  // namespace detail
+
+// Feeds the samples a[0..n) in order: the same result, bit for bit, as
+// step() on each.
+template <typename S, int N, typename Dev, typename T>
+void run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a, std::size_t n) {
+  std::size_t i = 0;
+  while (i < n) {
+    i += detail::run_exact(m, d, a + i, n - i);
+    if (i < n) step(m, d, static_cast<S>(a[i++]));
+  }
 }
 
 // E_e so far [J s].

@@ -13,3 +13,19 @@
 #else
 #define VINES_INLINE inline
 #endif
+
+// A branch the per-sample path takes rarely (a peak refined, a contact, a
+// guard tripped): the compiler then keeps the hot values in registers and
+// spills around the rare branch's calls, not on every sample.
+#if defined(__GNUC__) || defined(__clang__)
+#define VINES_UNLIKELY(x) __builtin_expect(!!(x), 0)
+#else
+#define VINES_UNLIKELY(x) (x)
+#endif
+
+// Kept out of line whatever the caller: see linear_steps in sim.hpp.
+#if defined(__GNUC__) || defined(__clang__)
+#define VINES_NOINLINE __attribute__((noinline))
+#else
+#define VINES_NOINLINE
+#endif
