@@ -72,6 +72,10 @@ struct DeviceModel<S, VinesDevice<L>> {
   // Contacts shallower than this are not counted: the scene's depth, but no
   // less than what the scalar resolves across the box (rounding fakes them).
   S count_depth;
+  // Overlaps below event_tol do not start a contact (rounding makes them when
+  // the particle rests against a wall); round_tol covers the rounding of the
+  // relative position s - x_f.
+  S event_tol, round_tol;
 };
 
 template <typename S, int N, typename Dev>
@@ -351,6 +355,10 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.w_step0 = static_cast<S>(0.02 * std::pow(static_cast<double>(dm.pos_scale), 0.25) / v_scale);
     const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
     dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));
+    constexpr S kEps = std::numeric_limits<S>::epsilon();
+    const S rtol = std::fmax(static_cast<S>(p.loop.contact_rtol), S(64) * kEps);
+    dm.event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2), S(64) * kEps * (dm.wall_right - dm.wall_left));
+    dm.round_tol = S(16) * kEps * (dm.wall_right - dm.wall_left);
   }
   return {};
 }

@@ -185,9 +185,10 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   d.ee_open = false;
 }
 
-// The particle may touch a wall within the step: it is in contact, or its
-// relative position may reach a wall (cubic through both ends of the free
-// step, with a margin for what a cubic misses).
+// The particle may touch a wall within the step: its overlap with a wall may
+// exceed the event tolerance, where the sub-stepper would start a contact
+// (cubic through both ends of the free step, with a margin for what a cubic
+// misses and for rounding). A particle resting against a wall is not touching.
 template <typename S, int N, typename Dev>
 VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Carry<S>& d, S s1, S sd1, S xf1, S vf1) {
   const auto& dm = m.dev;
@@ -196,14 +197,13 @@ VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Carry<S>& d, S s1, 
   const S r1 = s1 - xf1, rd1 = sd1 - vf1;
   // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
   // bounded by its end values plus what the cubic allows between them.
-  const S tiny = S(1e-9) * (dm.wall_right - dm.wall_left);
-  const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + tiny;
+  const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
   const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
-  if (!VINES_UNLIKELY(!(lo > dm.wall_left && hi < dm.wall_right))) return false;
-  const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + tiny;
+  if (!VINES_UNLIKELY(!(lo > dm.wall_left - dm.event_tol && hi < dm.wall_right + dm.event_tol))) return false;
+  const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + dm.round_tol;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
   const auto right = numeric::Cubic<S>::make(r0 - dm.wall_right, rd0, r1 - dm.wall_right, rd1, h);
-  return left.max_value() + margin > S(0) || right.max_value() + margin > S(0);
+  return left.max_value() + margin > dm.event_tol || right.max_value() + margin > dm.event_tol;
 }
 
 // What became of an exact step.

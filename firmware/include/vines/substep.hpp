@@ -43,10 +43,7 @@ inline constexpr double kStickSpeed = 1e-6;
 // particle rests against a wall, and chasing them only churns events.
 template <typename S, int N, typename Dev>
 S event_tolerance(const Model<S, N, Dev>& m) {
-  const auto& dm = m.dev;
-  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
-  return std::fmax(rtol * dm.pos_scale * S(1e-2),
-                   S(64) * std::numeric_limits<S>::epsilon() * (dm.wall_right - dm.wall_left));
+  return m.dev.event_tol;
 }
 
 // Overlap with the left and right walls for a relative position r = s - x_f
