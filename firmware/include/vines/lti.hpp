@@ -90,8 +90,8 @@ struct ModalRows {
 
 // Exact step of z0 to z1 with its readouts (WithDev: a device floor is read).
 template <bool WithDev, typename S, int P>
-VINES_INLINE StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw, const Eigen::Matrix<S, 2 * P, 1>& z0,
-                      Eigen::Matrix<S, 2 * P, 1>& z1, S a0, S a1) {
+VINES_INLINE StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw,
+                                   const Eigen::Matrix<S, 2 * P, 1>& z0, Eigen::Matrix<S, 2 * P, 1>& z1, S a0, S a1) {
   using Arr = Eigen::Array<S, P, 1>;
   const auto q = z0.template head<P>().array();
   const auto v = z0.template tail<P>().array();

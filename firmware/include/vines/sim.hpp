@@ -11,8 +11,8 @@
 //      counted);
 //   3. guards (non-finite input held, diverging steps rolled back), counters.
 // Work per step is bounded; no heap, no exceptions. run() feeds a block of
-// samples: the same steps, with each run of plain exact steps done on a
-// local copy of the step state that stays in registers.
+// samples: the same steps, with runs of plain exact steps taken in blocks
+// (the frame through the block, then the particle and the checks).
 #pragma once
 
 #include <cmath>
@@ -334,7 +334,10 @@ namespace detail {
 template <typename S, int N, typename Dev, typename T>
 std::size_t run_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a, std::size_t n) {
   using VecX = typename Model<S, N, Dev>::VecX;
-  constexpr int kMax = 32;  // largest block
+  // Largest block: 32 steps, or fewer when the states would pass 8 KB of
+  // stack (frames of many stories).
+  constexpr int kFit = static_cast<int>(8192 / sizeof(VecX));
+  constexpr int kMax = kFit < 4 ? 4 : (kFit > 32 ? 32 : kFit);
   if (m.loop.energy_ledger || m.loop.floor_peaks) return 0;
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     if (d.mode != Mode::kFree) return 0;
