@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -156,23 +157,40 @@ TEST(Stress, ACaseIsWrittenAsASceneThatRunsTheSame) {
 
 // Engine::run (a whole record in one call, as bench and sweep use) is the
 // sample-by-sample loop: the same totals to the bit.
+// Engine::run (the firmware's run(): blocks of exact steps) and step() give
+// the same run bit for bit: with the outputs a study reads (run's block path)
+// and with the energy ledger and per-floor peaks (step by step), through a
+// non-finite sample.
 TEST(Stress, EngineRunIsTheStepLoop) {
-  const StressCase c = case_with_contacts(ContactLaw::kKuwabara);
-  const std::vector<double> a = case_samples(c, records());
-  auto stepped = make_engine(c.params, c.scalar), whole = make_engine(c.params, c.scalar);
-  ASSERT_TRUE(stepped->build(c.params).ok());
-  ASSERT_TRUE(whole->build(c.params).ok());
-  stepped->init(a[0]);
-  for (std::size_t k = 1; k < a.size(); ++k) stepped->step(a[k]);
-  whole->init(a[0]);
-  whole->run(a.data() + 1, a.size() - 1);
-  const RunTotals s = stepped->totals(), w = whole->totals();
-  EXPECT_GT(w.count.contacts, 0);
-  EXPECT_EQ(w.count.steps, static_cast<std::int64_t>(a.size() - 1));
-  EXPECT_EQ(w.peak_top, s.peak_top);
-  EXPECT_EQ(w.elastic_energy, s.elastic_energy);
-  EXPECT_EQ(w.count.substeps, s.count.substeps);
-  EXPECT_EQ(w.count.contacts, s.count.contacts);
+  StressCase c = case_with_contacts(ContactLaw::kKuwabara);
+  std::vector<double> a = case_samples(c, records());
+  a[a.size() / 3] = std::numeric_limits<double>::quiet_NaN();
+  for (const bool outputs : {false, true}) {
+    c.params.loop.energy_ledger = outputs;
+    c.params.loop.floor_peaks = outputs;
+    auto stepped = make_engine(c.params, c.scalar), whole = make_engine(c.params, c.scalar);
+    ASSERT_TRUE(stepped->build(c.params).ok());
+    ASSERT_TRUE(whole->build(c.params).ok());
+    stepped->init(a[0]);
+    for (std::size_t k = 1; k < a.size(); ++k) stepped->step(a[k]);
+    whole->init(a[0]);
+    whole->run(a.data() + 1, a.size() - 1);
+    const RunTotals s = stepped->totals(), w = whole->totals();
+    EXPECT_GT(w.count.contacts, 0);
+    EXPECT_EQ(w.count.steps, static_cast<std::int64_t>(a.size() - 1));
+    EXPECT_EQ(w.count.bad_samples, 1);
+    EXPECT_EQ(w.peak_top, s.peak_top);
+    EXPECT_EQ(w.t_peak_top, s.t_peak_top);
+    EXPECT_EQ(w.peak_top_velocity, s.peak_top_velocity);
+    EXPECT_EQ(w.elastic_energy, s.elastic_energy);
+    EXPECT_EQ(w.max_overlap, s.max_overlap);
+    EXPECT_EQ(w.count.careful_steps, s.count.careful_steps);
+    EXPECT_EQ(w.count.substeps, s.count.substeps);
+    EXPECT_EQ(w.count.contacts, s.count.contacts);
+    EXPECT_EQ(w.count.bad_samples, s.count.bad_samples);
+    EXPECT_EQ(w.count.divergences, s.count.divergences);
+    EXPECT_EQ(w.ledger.residual, s.ledger.residual);
+  }
 }
 
 // ---- sub-step cap ----
