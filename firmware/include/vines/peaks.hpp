@@ -41,8 +41,8 @@ void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>
 // Peak of |top floor| over an exact step from (x0, v0) at z0 to (x1, v1) at
 // z1 when the step can beat the running peak (by a cheap bound from both
 // ends), else 0: quintic Hermite with the accelerations at both ends (error
-// ~h^6), for a converged peak at any rate. All but the quintic is inline and
-// takes no address of a state: the caller's state may stay in registers.
+// ~h^6), for a converged peak at any rate; the accelerations are a row of the
+// model each (top_a), the quintic is the only call.
 template <typename S, int N, typename Dev>
 VINES_INLINE S top_peak_of_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                 const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1,

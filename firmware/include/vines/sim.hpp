@@ -103,11 +103,7 @@ VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model
                                  S vprobe) {
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
   if (VINES_UNLIKELY(!std::isfinite(bound + vprobe))) return true;  // bound >= 0: an infinity stays one
-  if (VINES_UNLIKELY(bound > limit)) {  // floor by floor (no temporary holding z's address)
-    for (int i = 0; i < N; ++i) {
-      if (!(std::fabs(m.pos_map.row(i).dot(z.template head<Model<S, N, Dev>::kP>())) <= limit)) return true;
-    }
-  }
+  if (VINES_UNLIKELY(bound > limit) && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     if (!(std::fabs(z(N)) <= limit)) return true;
   }
@@ -158,22 +154,18 @@ VINES_NOINLINE void linear_steps(const Model<S, N, Dev>& m, const typename Model
 
 // E_e over the exact step from z (r: its readouts). With the Lyapunov
 // split, a run of exact steps opens with V(z) added (E_e is then
-// ee_sum - V(z_now)) and each step adds its linear form. The forms are
-// evaluated on a copy of z: its address is not taken, and run_exact's motion
-// may stay in registers.
+// ee_sum - V(z_now)) and each step adds its linear form.
 template <typename S, int N, typename Dev>
 VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
                                    const typename Model<S, N, Dev>::VecX& z, const StepRead<S>& r, S a0, S a1) {
   if (m.ee_lyapunov) {
     if (VINES_UNLIKELY(!d.ee_open)) {
-      const typename Model<S, N, Dev>::VecX z0 = z;
-      d.ee_sum += static_cast<double>(m.ee_boundary.eval(z0, S(0)));
+      d.ee_sum += static_cast<double>(m.ee_boundary.eval(z, S(0)));
       d.ee_open = true;
     }
     d.ee_sum += static_cast<double>(r.lin);
   } else {
-    const typename Model<S, N, Dev>::VecX z0 = z;
-    d.ee_sum += static_cast<double>(m.strain_step.eval(z0, a0, a1));
+    d.ee_sum += static_cast<double>(m.strain_step.eval(z, a0, a1));
   }
 }
 
@@ -199,7 +191,7 @@ VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Carry<S>& d, S s1, 
   // bounded by its end values plus what the cubic allows between them.
   const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
   const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
-  if (!VINES_UNLIKELY(!(lo > dm.wall_left - dm.event_tol && hi < dm.wall_right + dm.event_tol))) return false;
+  if (VINES_LIKELY(lo > dm.wall_left - dm.event_tol && hi < dm.wall_right + dm.event_tol)) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + dm.round_tol;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
   const auto right = numeric::Cubic<S>::make(r0 - dm.wall_right, rd0, r1 - dm.wall_right, rd1, h);

@@ -15,12 +15,15 @@
 #endif
 
 // A branch the per-sample path takes rarely (a peak refined, a contact, a
-// guard tripped): the compiler then keeps the hot values in registers and
-// spills around the rare branch's calls, not on every sample.
+// guard tripped), or nearly always (the particle clear of the walls): the
+// compiler then keeps the hot values in registers and spills around the rare
+// branch's calls, not on every sample.
 #if defined(__GNUC__) || defined(__clang__)
 #define VINES_UNLIKELY(x) __builtin_expect(!!(x), 0)
+#define VINES_LIKELY(x) __builtin_expect(!!(x), 1)
 #else
 #define VINES_UNLIKELY(x) (x)
+#define VINES_LIKELY(x) (x)
 #endif
 
 // Kept out of line whatever the caller: see linear_steps in sim.hpp.
