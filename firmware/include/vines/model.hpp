@@ -72,9 +72,9 @@ struct DeviceModel<S, VinesDevice<L>> {
   // Contacts shallower than this are not counted: the scene's depth, but no
   // less than what the scalar resolves across the box (rounding fakes them).
   S count_depth;
-  // Overlaps below event_tol do not start a contact (rounding makes them when
-  // the particle rests against a wall); round_tol covers the rounding of the
-  // relative position s - x_f.
+  // Overlaps below event_tol [m] do not start a contact: rounding makes them
+  // when the particle rests against a wall, and chasing them only churns
+  // events. round_tol covers the rounding of the relative position s - x_f.
   S event_tol, round_tol;
 };
 

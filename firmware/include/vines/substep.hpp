@@ -39,13 +39,6 @@ namespace vines {
 // resolved one by one (hundreds of thousands of impacts).
 inline constexpr double kStickSpeed = 1e-6;
 
-// Overlaps below this [m] do not start a contact: rounding makes them when the
-// particle rests against a wall, and chasing them only churns events.
-template <typename S, int N, typename Dev>
-S event_tolerance(const Model<S, N, Dev>& m) {
-  return m.dev.event_tol;
-}
-
 // Overlap with the left and right walls for a relative position r = s - x_f
 // (positive means interpenetration).
 template <typename S, typename DM>
@@ -272,7 +265,7 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
       // and the overlap drifted apart): then q goes back on the overlap.
       const S r = st.rel_pos(y);
       const S dl = st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
-      if (dl > event_tolerance(m)) {
+      if (dl > m.dev.event_tol) {
         y(Stepper::kQ) = std::sqrt(std::sqrt(dl));
         break;
       }
@@ -293,7 +286,7 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   const auto& dm = m.dev;
-  const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = event_tolerance(m);
+  const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = m.dev.event_tol;
   switch (st.mode) {
     case Mode::kFree: {
       // An impact needs an approach speed the law resolves (a particle just
@@ -333,7 +326,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   constexpr S kEps = std::numeric_limits<S>::epsilon();
   // Tolerances that the scalar can honour.
   const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * kEps);
-  const S event_tol = event_tolerance(m);
+  const S event_tol = m.dev.event_tol;
   const int cap = m.loop.max_substeps_per_step;
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
