@@ -48,15 +48,26 @@ struct Counters {
   std::int64_t divergences = 0;   // steps rolled back by the divergence guard
 };
 
-// The scalars a step carries to the next besides the linear state: the VI
-// NES particle and the floors it moves against. A run of free steps keeps
-// them in registers (run_exact() in sim.hpp).
+// What a step carries to the next besides the linear state: the VI NES
+// particle, the floors it moves against, the clock and the running outputs
+// of exact steps. A run of plain exact steps keeps it in registers
+// (plain_steps() in sim.hpp) and writes it back once at the end.
 template <typename S>
 struct Carry {
   // VI NES particle: s = displacement from its start (relative to ground).
   S s = S(0), sd = S(0);
   // The top floor and the device floor now.
   S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
+  std::int64_t k = 0;  // samples consumed; the state is at t = k h
+  // Running maxima of the top floor: |x| continuous in time (reached at
+  // t_peak_top), |v| at the samples.
+  S peak_top = S(0), peak_top_velocity = S(0);
+  double t_peak_top = 0;
+  // E_e = integral of (1/2) x^T K x dt [J s] is ee_sum, less V(z) while a run
+  // of exact steps is open (ee_open; see lyapunov_split): read it with
+  // elastic_energy(m, d).
+  double ee_sum = 0;
+  bool ee_open = false;
 };
 
 template <typename S, int N, typename Dev>
@@ -67,7 +78,6 @@ struct Data : Carry<S> {
 
   VecX z = VecX::Zero();    // linear part
   S a_prev = S(0);          // ground acceleration at the current time
-  std::int64_t k = 0;       // samples consumed; the state is at t = k h
   Mode mode = Mode::kFree;  // VI NES
   S substep = S(0);         // last sub-step size in t (carried across steps)
   S substep_w = S(0);       // last sub-step size in w inside a contact
@@ -76,23 +86,15 @@ struct Data : Carry<S> {
   S contact_depth = S(0);   // deepest overlap of the current contact
   S max_overlap = S(0);     // deepest overlap of the run
 
-  // Running maxima over the whole run (continuous in time, not just samples);
-  // per floor only with loop.floor_peaks.
+  // Running maxima per floor (continuous in time, not just samples), only
+  // with loop.floor_peaks; the top floor's are in Carry.
   VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();
-  S peak_top = S(0);
-  double t_peak_top = 0;
-  S peak_top_velocity = S(0);  // largest |v| of the top floor at the samples
-  // E_e = integral of (1/2) x^T K x dt [J s] is ee_sum, less V(z) while a run
-  // of exact steps is open (ee_open; see lyapunov_split): read it with
-  // elastic_energy(m, d).
-  double ee_sum = 0;
-  bool ee_open = false;
   double strain_increments = 0;  // sum of positive increments of the strain energy [J] (floor_peaks)
   double last_strain = 0;
   Ledger ledger;
   Counters count;
 
-  double time(const M& m) const { return static_cast<double>(k) * m.h; }
+  double time(const M& m) const { return static_cast<double>(this->k) * m.h; }
 };
 
 }  // namespace vines

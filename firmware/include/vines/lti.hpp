@@ -20,6 +20,7 @@
 
 #include "vines/numeric/expm.hpp"
 #include "vines/numeric/inline.hpp"
+#include "vines/numeric/sums.hpp"
 
 namespace vines {
 
@@ -75,7 +76,7 @@ struct ModalLti {
 // NaN).
 template <typename S>
 struct StepRead {
-  S xt, vt, xf, vf, bound, vprobe, lin;
+  S xt, vt, bound, lin, xf, vf, vprobe;
 };
 
 template <typename S, int P>
@@ -88,27 +89,37 @@ struct ModalRows {
   bool dev_is_top = true;       // the device floor is the top floor (xf = xt)
 };
 
-// Exact step of z0 to z1 with its readouts (WithDev: a device floor is read).
-template <bool WithDev, typename S, int P>
+// Exact step of z0 to z1 with its readouts (WithDev: a device floor is
+// read). L: the SIMD width the modes are padded to (numeric/sums.hpp).
+template <bool WithDev, int L, typename S, int P>
 VINES_INLINE StepRead<S> step_read(const ModalLti<S, P>& l, const ModalRows<S, P>& rw,
                                    const Eigen::Matrix<S, 2 * P, 1>& z0, Eigen::Matrix<S, 2 * P, 1>& z1, S a0, S a1) {
   using Arr = Eigen::Array<S, P, 1>;
+  using Pack = numeric::Lanes<S, L>;
   const auto q = z0.template head<P>().array();
   const auto v = z0.template tail<P>().array();
-  StepRead<S> r;
-  r.lin = (q * (rw.lq0.array() * a0 + rw.lq1.array() * a1) + v * (rw.lv0.array() * a0 + rw.lv1.array() * a1)).sum() +
-          a0 * (rw.l00 * a0 + rw.l01 * a1) + rw.l11 * a1 * a1;
+  // The E_e form's parts in a0 and a1, from the state before the step.
+  Pack y0 = numeric::fold_dot<L, P, S>(rw.lq0.array(), q), y1 = numeric::fold_dot<L, P, S>(rw.lq1.array(), q);
+  numeric::fold_dot_add<L, P>(y0, rw.lv0.array(), v);
+  numeric::fold_dot_add<L, P>(y1, rw.lv1.array(), v);
   const Arr q1 = l.p11.array() * q + l.p12.array() * v + l.gx0.array() * a0 + l.gx1.array() * a1;
   const Arr v1 = l.p21.array() * q + l.p22.array() * v + l.gv0.array() * a0 + l.gv1.array() * a1;
-  r.xt = (rw.top.array() * q1).sum();
-  r.vt = (rw.top.array() * v1).sum();
+  // The top floor's x and v and the floor bound, after it.
+  const Pack xt = numeric::fold_dot<L, P, S>(rw.top.array(), q1);
+  const Pack vt = numeric::fold_dot<L, P, S>(rw.top.array(), v1);
+  const Pack bound = numeric::fold_dot<L, P, S>(rw.bound.array(), q1.abs());
+  const numeric::Lanes<S, 4> sums = numeric::lane_sums<S, L>(xt, vt, bound, y0 * a0 + y1 * a1);
+  StepRead<S> r;
+  r.xt = sums(0);
+  r.vt = sums(1);
+  r.bound = sums(2);
+  r.lin = sums(3) + a0 * (rw.l00 * a0 + rw.l01 * a1) + rw.l11 * a1 * a1;
   r.xf = r.xt;
   r.vf = r.vt;
   if (WithDev && !rw.dev_is_top) {
     r.xf = (rw.dev.array() * q1).sum();
     r.vf = (rw.dev.array() * v1).sum();
   }
-  r.bound = (rw.bound.array() * q1.abs()).sum();
   r.vprobe = r.vt;
   z1.template head<P>() = q1.matrix();
   z1.template tail<P>() = v1.matrix();

@@ -75,7 +75,9 @@ struct DeviceModel<S, VinesDevice<L>> {
   // Overlaps below event_tol [m] do not start a contact: rounding makes them
   // when the particle rests against a wall, and chasing them only churns
   // events. round_tol covers the rounding of the relative position s - x_f.
-  S event_tol, round_tol;
+  // A free step stays clear of the walls while s - x_f stays inside
+  // (clear_lo, clear_hi): the walls widened by event_tol.
+  S event_tol, round_tol, clear_lo, clear_hi;
 };
 
 template <typename S, int N, typename Dev>
@@ -359,6 +361,8 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     const S rtol = std::fmax(static_cast<S>(p.loop.contact_rtol), S(64) * kEps);
     dm.event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2), S(64) * kEps * (dm.wall_right - dm.wall_left));
     dm.round_tol = S(16) * kEps * (dm.wall_right - dm.wall_left);
+    dm.clear_lo = dm.wall_left - dm.event_tol;
+    dm.clear_hi = dm.wall_right + dm.event_tol;
   }
   return {};
 }

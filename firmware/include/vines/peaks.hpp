@@ -38,6 +38,17 @@ void update_peaks(const Eigen::Matrix<S, N, 1>& x0, const Eigen::Matrix<S, N, 1>
   }
 }
 
+// Bound on |x| over a step of length h from (x0, v0) to (x1, v1), from
+// |x| and |v| at both ends: what a step must beat to be refined.
+template <typename S>
+VINES_INLINE S abs_bound(S ax0, S av0, S ax1, S av1, S h) {
+  return numeric::max_of(ax0, ax1) + S(0.5) * h * (av0 + av1);
+}
+template <typename S>
+VINES_INLINE S top_bound(S x0, S v0, S x1, S v1, S h) {
+  return abs_bound(std::fabs(x0), std::fabs(v0), std::fabs(x1), std::fabs(v1), h);
+}
+
 // Peak of |top floor| over an exact step from (x0, v0) at z0 to (x1, v1) at
 // z1 when the step can beat the running peak (by a cheap bound from both
 // ends), else 0: quintic Hermite with the accelerations at both ends (error
@@ -47,16 +58,14 @@ template <typename S, int N, typename Dev>
 VINES_INLINE S top_peak_of_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                 const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1,
                                 S peak) {
-  const S bound = numeric::max_of(std::fabs(x0), std::fabs(x1)) + S(0.5) * m.hs * (std::fabs(v0) + std::fabs(v1));
-  if (!VINES_UNLIKELY(bound > peak)) return S(0);
+  if (!VINES_UNLIKELY(top_bound(x0, v0, x1, v1, m.hs) > peak)) return S(0);
   return numeric::quintic_abs_max(x0, v0, m.top_a(z0, a0), x1, v1, m.top_a(z1, a1), m.hs);
 }
 
 // Peak of the top floor over a sub-step of length h (cubic Hermite).
 template <typename S, int N, typename Dev>
 void update_top_peak_cubic(Data<S, N, Dev>& d, S x0, S v0, S x1, S v1, S h, double t1) {
-  const S bound = numeric::max_of(std::fabs(x0), std::fabs(x1)) + S(0.5) * h * (std::fabs(v0) + std::fabs(v1));
-  if (bound <= d.peak_top) return;
+  if (top_bound(x0, v0, x1, v1, h) <= d.peak_top) return;
   const S p = std::fmax(numeric::Cubic<S>::make(x0, v0, x1, v1, h).max_value(),
                         numeric::Cubic<S>::make(-x0, -v0, -x1, -v1, h).max_value());
   if (p > d.peak_top) {

@@ -5,7 +5,8 @@
 //      a VI NES checks whether its particle may touch a wall during the step;
 //   2. if not: the exact step is committed with its exact step integrals
 //      (E_e; the energy ledger and per-floor peaks only when asked for);
-//      E_e by the Lyapunov split, a linear form per step;
+//      E_e by the Lyapunov split, a linear form per step; a plain step
+//      (nothing but the common case) in a tight loop, any other in full;
 //      if so: adaptive Dormand-Prince sub-steps through the step, contact
 //      starts and ends located to rounding, capped per step (cap hits are
 //      counted);
@@ -126,13 +127,19 @@ template <typename S, int N, typename Dev>
 VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                      typename Model<S, N, Dev>::VecX& z1, S a0, S a1) {
   if constexpr (Model<S, N, Dev>::kModal) {
-    return step_read<Dev::kKind == DeviceKind::kVines>(m.lti, m.rows, z0, z1, a0, a1);
+    return step_read<Dev::kKind == DeviceKind::kVines, Layout<Dev, N>::kLanes>(m.lti, m.rows, z0, z1, a0, a1);
   } else {
     z1 = z0;
     m.lti.step(z1, a0, a1);
-    const S xt = m.top_x(z1), vt = m.top_v(z1);
-    return {xt, vt, m.dev_x(z1), m.dev_v(z1), m.floor_bound(z1),
-            z1.template tail<Model<S, N, Dev>::kP>().sum(), S(0)};
+    StepRead<S> r;
+    r.xt = m.top_x(z1);
+    r.vt = m.top_v(z1);
+    r.bound = m.floor_bound(z1);
+    r.lin = S(0);
+    r.xf = m.dev_x(z1);
+    r.vf = m.dev_v(z1);
+    r.vprobe = z1.template tail<Model<S, N, Dev>::kP>().sum();
+    return r;
   }
 }
 
@@ -145,10 +152,11 @@ VINES_INLINE StepRead<S> linear_step(const Model<S, N, Dev>& m, const typename M
 template <typename S, int N, typename Dev>
 VINES_NOINLINE void linear_steps(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                  typename Model<S, N, Dev>::VecX* zs, StepRead<S>* rs, const S* as, int n) {
-  typename Model<S, N, Dev>::VecX z = z0;
+  typename Model<S, N, Dev>::VecX z = z0, z1;
   for (int i = 0; i < n; ++i) {
-    rs[i] = linear_step(m, z, zs[i], as[i], as[i + 1]);
-    z = zs[i];
+    rs[i] = linear_step(m, z, z1, as[i], as[i + 1]);
+    zs[i] = z1;
+    z = z1;
   }
 }
 
@@ -156,8 +164,8 @@ VINES_NOINLINE void linear_steps(const Model<S, N, Dev>& m, const typename Model
 // split, a run of exact steps opens with V(z) added (E_e is then
 // ee_sum - V(z_now)) and each step adds its linear form.
 template <typename S, int N, typename Dev>
-VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d,
-                                   const typename Model<S, N, Dev>::VecX& z, const StepRead<S>& r, S a0, S a1) {
+VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Carry<S>& d, const typename Model<S, N, Dev>::VecX& z,
+                                   const StepRead<S>& r, S a0, S a1) {
   if (m.ee_lyapunov) {
     if (VINES_UNLIKELY(!d.ee_open)) {
       d.ee_sum += static_cast<double>(m.ee_boundary.eval(z, S(0)));
@@ -177,54 +185,126 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   d.ee_open = false;
 }
 
+// The particle (at r, r' relative to the device floor at both ends of a
+// free step) stays clear of both walls whatever its path in between, by
+// more than the event tolerance: |r - r0| <= h max|r'|, and r' is bounded by
+// its end values plus what a cubic through both ends allows between them.
+template <typename S, int N, typename Dev>
+VINES_INLINE bool clear_of_walls(const Model<S, N, Dev>& m, S r0, S rd0, S r1, S rd1) {
+  const auto& dm = m.dev;
+  const S reach = m.hs * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
+  const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
+  return lo > dm.clear_lo && hi < dm.clear_hi;
+}
+
 // The particle may touch a wall within the step: its overlap with a wall may
 // exceed the event tolerance, where the sub-stepper would start a contact
 // (cubic through both ends of the free step, with a margin for what a cubic
 // misses and for rounding). A particle resting against a wall is not touching.
 template <typename S, int N, typename Dev>
-VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, const Carry<S>& d, S s1, S sd1, S xf1, S vf1) {
+VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, S r0, S rd0, S r1, S rd1) {
   const auto& dm = m.dev;
   const S h = m.hs;
-  const S r0 = d.s - d.xf, rd0 = d.sd - d.vf;
-  const S r1 = s1 - xf1, rd1 = sd1 - vf1;
-  // Far from both walls whatever the path: |r - r0| <= h max|r'| and r' is
-  // bounded by its end values plus what the cubic allows between them.
-  const S reach = h * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
-  const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
-  if (VINES_LIKELY(lo > dm.wall_left - dm.event_tol && hi < dm.wall_right + dm.event_tol)) return false;
+  if (VINES_LIKELY(clear_of_walls(m, r0, rd0, r1, rd1))) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + dm.round_tol;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
   const auto right = numeric::Cubic<S>::make(r0 - dm.wall_right, rd0, r1 - dm.wall_right, rd1, h);
   return left.max_value() + margin > dm.event_tol || right.max_value() + margin > dm.event_tol;
 }
 
+// The clock and what is read at every sample, after a step (top floor now
+// at velocity vt).
+template <typename S>
+VINES_INLINE void end_step(Carry<S>& d, S vt) {
+  if (std::fabs(vt) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(vt);
+  ++d.k;
+}
+
+// Plain exact steps (readouts rs[i], samples as[i], as[i + 1], frame after
+// them zs[i]) taken one after another while each needs nothing but the
+// common case: the particle clear of the walls, the frame within its limit,
+// E_e by the open Lyapunov split, the top floor below its running peak.
+// Commits them to c (the frame is the caller's) and returns how many; the
+// step it stops at goes to finish_exact(). A loop without calls, so that
+// what it carries stays in registers; out of line and shared by step() and
+// run_exact(), so that both compile one arithmetic (see linear_steps).
+template <typename S, int N, typename Dev>
+VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typename Model<S, N, Dev>::VecX* zs,
+                               const StepRead<S>* rs, const S* as, int n) {
+  if (!m.ee_lyapunov || !c.ee_open) return 0;
+  const S h = m.hs, limit = static_cast<S>(m.loop.divergence_limit_m), peak = c.peak_top;
+  // What a step hands the next: the particle (s, s') and relative to the
+  // floor (r, r'), the top floor's |x| and |v|. Two sets, a step reading one
+  // and writing the other, so that the loop needs no register moves.
+  struct Hand {
+    S s, sd, r, rd, ax, av;
+  };
+  S vpeak = c.peak_top_velocity;
+  double ee = c.ee_sum;
+  // Step i from a to b; false (b untouched) if step i is not plain.
+  auto advance = [&](const Hand& a, Hand& b, int i) {
+    const StepRead<S>& r = rs[i];
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      free_flight(m, a.s, a.sd, as[i], as[i + 1], &b.s, &b.sd);
+      b.r = b.s - r.xf;
+      b.rd = b.sd - r.vf;
+      if (!clear_of_walls(m, a.r, a.rd, b.r, b.rd)) return false;
+    }
+    // Within the limit, and finite (v - v is NaN for an infinite or NaN v).
+    if (!(r.bound + (r.vprobe - r.vprobe) <= limit)) return false;
+    if constexpr (Dev::kKind == DeviceKind::kTmd) {
+      if (!(std::fabs(zs[i](N)) <= limit)) return false;
+    }
+    b.ax = std::fabs(r.xt);
+    b.av = std::fabs(r.vt);
+    if (abs_bound(a.ax, a.av, b.ax, b.av, h) > peak) return false;
+    ee += static_cast<double>(r.lin);
+    vpeak = numeric::max_of(vpeak, b.av);
+    return true;
+  };
+  Hand x{c.s, c.sd, c.s - c.xf, c.sd - c.vf, std::fabs(c.xt), std::fabs(c.vt)}, y = x;
+  int i = 0;
+  while (i < n && advance(x, y, i) && ++i < n && advance(y, x, i)) ++i;
+  const Hand& last = i % 2 ? y : x;
+  if (i > 0) {
+    c.xt = rs[i - 1].xt;
+    c.vt = rs[i - 1].vt;
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      c.s = last.s;
+      c.sd = last.sd;
+      c.xf = rs[i - 1].xf;
+      c.vf = rs[i - 1].vf;
+    }
+    c.peak_top_velocity = vpeak;
+    c.ee_sum = ee;
+    c.k += i;
+  }
+  return i;
+}
+
 // What became of an exact step.
 enum class Exact : unsigned char { kDone, kCareful, kDiverged };
 
 // Finishes the exact step of the linear part from z0 to z1 (readouts r),
-// from a0 to a1: the particle flies, and the step is committed with its step
-// integrals (kDone), unless the VI NES particle may touch a wall during it
-// (kCareful) or the frame diverged (kDiverged), which change nothing. c is
-// what the step carries (d itself in step(), a copy in registers in
-// run_exact()); the caller commits z1. extras(z1) runs just before the
-// commit (at the step's start): the energy ledger and per-floor peaks, when
-// kept.
-template <typename S, int N, typename Dev, typename Extras>
-VINES_INLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, Data<S, N, Dev>& d,
-                                const typename Model<S, N, Dev>::VecX& z0, const typename Model<S, N, Dev>::VecX& z1,
-                                const StepRead<S>& r, S a0, S a1, Extras&& extras) {
+// from a0 to a1, in full: the particle flies, and the step is committed to c
+// with its step integrals (kDone; the caller commits z1 and ends the step),
+// unless the VI NES particle may touch a wall during it (kCareful) or the
+// frame diverged (kDiverged), which change nothing. Out of line, shared by
+// step() and run_exact() (see plain_steps).
+template <typename S, int N, typename Dev>
+VINES_NOINLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, const typename Model<S, N, Dev>::VecX& z0,
+                                  const typename Model<S, N, Dev>::VecX& z1, const StepRead<S>& r, S a0, S a1) {
   S s1 = S(0), sd1 = S(0);  // the particle (VI NES)
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     free_flight(m, c.s, c.sd, a0, a1, &s1, &sd1);
-    if (may_touch(m, c, s1, sd1, r.xf, r.vf)) return Exact::kCareful;
+    if (may_touch(m, c.s - c.xf, c.sd - c.vf, s1 - r.xf, sd1 - r.vf)) return Exact::kCareful;
   }
   if (VINES_UNLIKELY(frame_diverged(m, z1, r.bound, r.vprobe))) return Exact::kDiverged;
-  add_elastic_step(m, d, z0, r, a0, a1);
-  extras(z1);
-  const S peak = top_peak_of_step(m, z0, z1, a0, a1, c.xt, c.vt, r.xt, r.vt, d.peak_top);
-  if (VINES_UNLIKELY(peak > d.peak_top)) {
-    d.peak_top = peak;
-    d.t_peak_top = d.time(m) + m.h;
+  add_elastic_step(m, c, z0, r, a0, a1);
+  const S peak = top_peak_of_step(m, z0, z1, a0, a1, c.xt, c.vt, r.xt, r.vt, c.peak_top);
+  if (VINES_UNLIKELY(peak > c.peak_top)) {
+    c.peak_top = peak;
+    c.t_peak_top = static_cast<double>(c.k) * m.h + m.h;
   }
   c.xt = r.xt;
   c.vt = r.vt;
@@ -237,12 +317,18 @@ VINES_INLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, Data<S, 
   return Exact::kDone;
 }
 
-// The clock and what is read at every sample, after a step (top floor now
-// at velocity vt).
+// What an exact step from d.z to z1 keeps when asked: the energy ledger
+// (sd0: the particle's speed before the step) and per-floor peaks.
 template <typename S, int N, typename Dev>
-VINES_INLINE void end_step(Data<S, N, Dev>& d, S vt) {
-  if (std::fabs(vt) > d.peak_top_velocity) d.peak_top_velocity = std::fabs(vt);
-  ++d.k;
+void keep_extras(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S a0,
+                 S a1, S sd0) {
+  if (m.loop.energy_ledger) {
+    d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
+    d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
+    if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, sd0, a0, a1);
+  }
+  if (m.loop.floor_peaks)
+    update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.hs, d.peak_x, d.peak_drift);
 }
 
 }  // namespace detail
@@ -261,25 +347,23 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
   }
   const S a0 = d.a_prev;
 
-  // 1.-2a. Exact step, committed unless it needs care or diverged.
-  bool careful = false;
+  // 1.-2a. Exact step, committed unless it needs care or diverged: a plain
+  // step if it can be, else in full.
+  bool careful = false, plain = false;
   if constexpr (Dev::kKind == DeviceKind::kVines) careful = d.mode != Mode::kFree;
   if (!careful) {
     VecX z1;
     StepRead<S> r;
     const S as[2] = {a0, a1};
     detail::linear_steps(m, d.z, &z1, &r, as, 1);
-    const detail::Exact e = detail::finish_exact(m, d, d, d.z, z1, r, a0, a1, [&m, &d, a0, a1](const VecX& z) {
-      if (m.loop.energy_ledger) {
-        d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
-        d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
-        if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, d.sd, a0, a1);
-      }
-      if (m.loop.floor_peaks)
-        detail::update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z), m.floor_v(z), m.hs, d.peak_x,
-                                   d.peak_drift);
-    });
-    if (e == detail::Exact::kDone) d.z = z1;
+    const bool extras = m.loop.energy_ledger || m.loop.floor_peaks;
+    plain = !extras && detail::plain_steps(m, d, &z1, &r, as, 1) == 1;
+    const S sd0 = d.sd;
+    const detail::Exact e = plain ? detail::Exact::kDone : detail::finish_exact(m, d, d.z, z1, r, a0, a1);
+    if (e == detail::Exact::kDone) {
+      if (extras) detail::keep_extras(m, d, z1, a0, a1, sd0);
+      d.z = z1;
+    }
     careful = e == detail::Exact::kCareful;
     if (e == detail::Exact::kDiverged) ++d.count.divergences;
   }
@@ -301,8 +385,8 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
     }
   }
 
-  // 3. Bookkeeping.
-  detail::end_step(d, d.vt);
+  // 3. Bookkeeping (a plain step has done its own).
+  if (!plain) detail::end_step(d, d.vt);
   d.a_prev = a1;
   ++d.count.steps;
   if (m.loop.floor_peaks) {
@@ -315,14 +399,15 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
 
 namespace detail {
 
-// Plain exact steps from a[0] on, as many as follow one another (the VI NES
+// Exact steps from a[0] on, as many as follow one another (the VI NES
 // particle free and clear of the walls, finite samples, no energy ledger or
 // per-floor peaks to keep), with step()'s arithmetic, block by block: first
 // the frame through the block (it does not depend on the particle while the
 // particle flies free), then the particle, guards, peaks and E_e step by
-// step, with what they carry in registers, up to the first step that is not
-// a plain exact step. Blocks grow from one step, so a run that ends at once
-// wastes little frame work. Returns the samples consumed.
+// step (plain_steps, and finish_exact for a step that is not plain), up to
+// the first step that needs care or diverged. Blocks grow from one step, so
+// a run that ends at once wastes little frame work. Returns the samples
+// consumed.
 template <typename S, int N, typename Dev, typename T>
 std::size_t run_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a, std::size_t n) {
   using VecX = typename Model<S, N, Dev>::VecX;
@@ -349,15 +434,14 @@ std::size_t run_exact(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a,
       as[nf + 1] = a1;
     }
     linear_steps(m, d.z, zs, rs, as, nf);
-    // 2. The rest, step by step.
-    Carry<S> c = d;
+    // 2. The rest, step by step: plain steps in a run, any other in full.
     int j = 0;
-    for (; j < nf; ++j) {
-      const VecX& z0 = j ? zs[j - 1] : d.z;
-      if (finish_exact(m, c, d, z0, zs[j], rs[j], as[j], as[j + 1], [](const VecX&) {}) != Exact::kDone) break;
-      end_step(d, c.vt);
+    while (j < nf) {
+      j += plain_steps(m, d, zs + j, rs + j, as + j, nf - j);
+      if (j == nf || finish_exact(m, d, j ? zs[j - 1] : d.z, zs[j], rs[j], as[j], as[j + 1]) != Exact::kDone) break;
+      end_step(d, d.vt);
+      ++j;
     }
-    static_cast<Carry<S>&>(d) = c;
     if (j > 0) {
       d.z = zs[j - 1];
       d.a_prev = as[j];
