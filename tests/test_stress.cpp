@@ -155,8 +155,6 @@ TEST(Stress, ACaseIsWrittenAsASceneThatRunsTheSame) {
   EXPECT_EQ(j["contacts"].get<long long>(), eng->totals().count.contacts);
 }
 
-// Engine::run (a whole record in one call, as bench and sweep use) is the
-// sample-by-sample loop: the same totals to the bit.
 // Engine::run (the firmware's run(): blocks of exact steps) and step() give
 // the same run bit for bit: with the outputs a study reads (run's block path)
 // and with the energy ledger and per-floor peaks (step by step), through a

@@ -99,12 +99,24 @@ namespace detail {
 // costs the floors themselves. frame_diverged is the check without the
 // particle: an exact step checks only that, its particle having passed
 // may_touch (strictly between the walls, finite position and speed).
+// frame_bounded is the cheap part alone, what a plain step needs: all finite
+// (v - v is NaN for an infinite or NaN v), the bound and a TMD within the
+// limit.
+template <typename S, int N, typename Dev>
+VINES_INLINE bool frame_bounded(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
+                                S vprobe) {
+  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  if (!(bound + (vprobe - vprobe) <= limit)) return false;
+  if constexpr (Dev::kKind == DeviceKind::kTmd) return std::fabs(z(N)) <= limit;
+  return true;
+}
 template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
                                  S vprobe) {
+  if (VINES_LIKELY(frame_bounded(m, z, bound, vprobe))) return false;
   const S limit = static_cast<S>(m.loop.divergence_limit_m);
-  if (VINES_UNLIKELY(!std::isfinite(bound + vprobe))) return true;  // bound >= 0: an infinity stays one
-  if (VINES_UNLIKELY(bound > limit) && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
+  if (!std::isfinite(bound + vprobe)) return true;  // bound >= 0: an infinity stays one
+  if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
     if (!(std::fabs(z(N)) <= limit)) return true;
   }
@@ -232,7 +244,7 @@ template <typename S, int N, typename Dev>
 VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typename Model<S, N, Dev>::VecX* zs,
                                const StepRead<S>* rs, const S* as, int n) {
   if (!m.ee_lyapunov || !c.ee_open) return 0;
-  const S h = m.hs, limit = static_cast<S>(m.loop.divergence_limit_m), peak = c.peak_top;
+  const S h = m.hs, peak = c.peak_top;
   // What a step hands the next: the particle (s, s') and relative to the
   // floor (r, r'), the top floor's |x| and |v|. Two sets, a step reading one
   // and writing the other, so that the loop needs no register moves.
@@ -250,11 +262,7 @@ VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typ
       b.rd = b.sd - r.vf;
       if (!clear_of_walls(m, a.r, a.rd, b.r, b.rd)) return false;
     }
-    // Within the limit, and finite (v - v is NaN for an infinite or NaN v).
-    if (!(r.bound + (r.vprobe - r.vprobe) <= limit)) return false;
-    if constexpr (Dev::kKind == DeviceKind::kTmd) {
-      if (!(std::fabs(zs[i](N)) <= limit)) return false;
-    }
+    if (!frame_bounded(m, zs[i], r.bound, r.vprobe)) return false;
     b.ax = std::fabs(r.xt);
     b.av = std::fabs(r.vt);
     if (abs_bound(a.ax, a.av, b.ax, b.av, h) > peak) return false;
