@@ -63,13 +63,16 @@ void set_errors(const Truth& truth, BenchLine* l) {
   l->x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l->x_r - truth.x_r) : kNaN;
 }
 
-// One firmware line: the scene at one scalar, rate and tolerance.
-BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, const Truth& truth,
+// One firmware line: the scene at one scalar, rate and tolerance, with the
+// adaptive contact scheme (substeps 0) or the bounded one with that budget.
+BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, int substeps, const Truth& truth,
                         const BenchOptions& opt) {
   Scene scene = base;
   scene.scalar = scalar;
   scene.params.loop.sensor_rate_hz = rate;
   scene.params.loop.contact_rtol = rtol;
+  scene.params.loop.contact_scheme = substeps > 0 ? ContactScheme::kBounded : ContactScheme::kAdaptive;
+  if (substeps > 0) scene.params.loop.bounded_substeps = substeps;
   if (!opt.full_outputs) {
     scene.params.loop.floor_peaks = false;
     scene.params.loop.energy_ledger = false;
@@ -82,6 +85,8 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   l.scalar = scalar_name(scalar);
   l.rate_hz = rate;
   l.rtol = rtol;
+  l.scheme = substeps > 0 ? "bounded" : "adaptive";
+  l.bounded_substeps = substeps;
   const auto b0 = std::chrono::steady_clock::now();
   std::unique_ptr<Engine> eng = built_engine(scene, scene.params, scalar);
   l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
@@ -96,6 +101,7 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   l.steps = t.count.steps;
   l.substeps = t.count.substeps;
   l.rejected = t.count.rejected;
+  l.max_substeps_in_step = t.count.max_substeps_in_step;
   l.peak_top = t.peak_top;
   l.elastic_energy = t.elastic_energy;
   l.contacts = static_cast<int>(t.count.contacts);
@@ -178,10 +184,27 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   // The tolerance only matters when there is a contact law to sub-step.
   const bool contacts = scene.params.device.kind == DeviceKind::kVines;
   const std::vector<double> rtols = opt.rtols.empty() || !contacts ? std::vector<double>{scene.params.loop.contact_rtol} : opt.rtols;
+  // Schemes: the adaptive one per tolerance, the bounded one per budget (at
+  // the scene's tolerance, which sets the event tolerance).
+  const LoopParams& loop = scene.params.loop;
+  std::vector<std::string> schemes = opt.schemes;
+  if (schemes.empty()) schemes = {loop.contact_scheme == ContactScheme::kBounded ? "bounded" : "adaptive"};
+  const std::vector<int> budgets = opt.bounded_substeps.empty() ? std::vector<int>{loop.bounded_substeps}
+                                                                 : opt.bounded_substeps;
   std::vector<BenchLine> lines;
   for (Scalar s : scalars)
     for (double rate : rates)
-      for (double rtol : rtols) lines.push_back(firmware_line(scene, s, rate, rtol, truth, opt));
+      for (const std::string& scheme : schemes) {
+        if (scheme == "adaptive") {
+          for (double rtol : rtols) lines.push_back(firmware_line(scene, s, rate, rtol, 0, truth, opt));
+        } else if (scheme == "bounded") {
+          for (int k : budgets)
+            if (contacts || k == budgets.front())
+              lines.push_back(firmware_line(scene, s, rate, loop.contact_rtol, k, truth, opt));
+        } else {
+          throw std::runtime_error("--schemes: unknown contact scheme '" + scheme + "' (adaptive, bounded)");
+        }
+      }
   for (reference::Method m : {reference::Method::kCvodeAdams, reference::Method::kCvodeBdf})
     for (double rtol : opt.baseline_rtols) lines.push_back(baseline_line(scene, m, rtol, truth, opt));
   return lines;
@@ -194,6 +217,9 @@ json line_json(const BenchLine& l) {
           {"scalar", l.scalar},
           {"sensor_rate_hz", l.rate_hz},
           {"contact_rtol", l.rtol},
+          {"contact_scheme", l.scheme},
+          {"bounded_substeps", l.method == "firmware" && l.scheme == "bounded" ? json(l.bounded_substeps) : json(nullptr)},
+          {"max_substeps_in_a_step", l.max_substeps_in_step},
           {"runs", l.runs},
           {"wall_s_median", l.wall_median_s},
           {"wall_s_min", l.wall_min_s},
@@ -213,15 +239,19 @@ json line_json(const BenchLine& l) {
 std::string format_table(const std::vector<BenchLine>& lines) {
   std::string out;
   char buf[320];
-  std::snprintf(buf, sizeof buf, "%-26s %-12s %-6s %8s %7s %10s %5s %8s %8s %9s %9s %9s %8s\n", "scene", "method",
-                "scalar", "rate_hz", "rtol", "wall_ms", "runs", "steps", "substeps", "peak_err", "Ee_err",
-                "x_r_err", "contacts");
+  std::snprintf(buf, sizeof buf, "%-26s %-12s %-10s %-6s %8s %7s %10s %5s %8s %8s %7s %9s %9s %9s %8s\n", "scene",
+                "method", "scheme", "scalar", "rate_hz", "rtol", "wall_ms", "runs", "steps", "substeps", "max_sub",
+                "peak_err", "Ee_err", "x_r_err", "contacts");
   out += buf;
   for (const BenchLine& l : lines) {
-    std::snprintf(buf, sizeof buf, "%-26s %-12s %-6s %8.0f %7.0e %10.4f %5d %8lld %8lld %9.2e %9.2e %9.2e %8d\n",
-                  l.scene.c_str(), l.method.c_str(), l.scalar.c_str(), l.rate_hz, l.rtol, 1e3 * l.wall_median_s,
-                  l.runs, l.steps, l.substeps, l.peak_rel_error, l.elastic_energy_rel_error, l.x_r_abs_error,
-                  l.contacts);
+    char scheme[32] = "";
+    if (l.method == "firmware")
+      std::snprintf(scheme, sizeof scheme, l.scheme == "bounded" ? "bounded/%d" : "adaptive", l.bounded_substeps);
+    std::snprintf(buf, sizeof buf,
+                  "%-26s %-12s %-10s %-6s %8.0f %7.0e %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
+                  l.scene.c_str(), l.method.c_str(), scheme, l.scalar.c_str(), l.rate_hz, l.rtol,
+                  1e3 * l.wall_median_s, l.runs, l.steps, l.substeps, l.max_substeps_in_step, l.peak_rel_error,
+                  l.elastic_energy_rel_error, l.x_r_abs_error, l.contacts);
     out += buf;
   }
   return out;

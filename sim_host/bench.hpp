@@ -29,6 +29,11 @@ struct Truth {
 // One line of the work-precision table.
 struct BenchLine {
   std::string scene, method, scalar;  // method: "firmware", "cvode-adams", "cvode-bdf"
+  // Firmware lines: the contact scheme ("adaptive", "bounded") and, bounded,
+  // its sub-step budget; the most sub-steps any step took.
+  std::string scheme = "adaptive";
+  int bounded_substeps = 0;
+  long long max_substeps_in_step = 0;
   double rate_hz = 0, rtol = 0;
   int runs = 0;
   double wall_median_s = 0, wall_min_s = 0, build_s = 0;
@@ -43,6 +48,10 @@ struct BenchOptions {
   std::vector<std::string> scalars;  // "double", "float"; empty: both
   std::vector<double> rates_hz;      // empty: the scene's own
   std::vector<double> rtols;         // contact sub-step tolerances; empty: the scene's own
+  // Contact schemes ("adaptive": a line per rtol; "bounded": a line per
+  // budget in bounded_substeps, empty: the scene's own); empty: the scene's.
+  std::vector<std::string> schemes;
+  std::vector<int> bounded_substeps;
   double min_time_s = 0.3;           // time each line for at least this long...
   int min_runs = 3;                  // ...and at least this many runs
   std::string reference_dir;         // "": data/reference of the source tree

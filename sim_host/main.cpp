@@ -44,9 +44,11 @@ constexpr const char* kUsage =
     "  design SCENE.toml --optimize beta|eps|mass_ratio|TABLE.KEY [options]\n"
     "      Best value of one design parameter for the scene's record or a set of\n"
     "      records (mean or worst case): coarse grid, then golden-section refinement.\n"
-    "  bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST] [--json]\n"
+    "  bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
+    "        [--schemes adaptive,bounded] [--substeps LIST] [--json]\n"
     "      Speed against accuracy: wall time of full runs and their error against the\n"
-    "      converged reference (data/reference), per sensor rate, tolerance and scalar.\n"
+    "      converged reference (data/reference), per sensor rate, tolerance (or bounded\n"
+    "      sub-step budget), contact scheme and scalar.\n"
     "  reference SCENE.toml [--rtol R] [--out FILE]\n"
     "      Integrate the scene and its bare frame with the converged reference\n"
     "      (DOP853 in long double, events located to rounding) at rtol R and 100 R;\n"
@@ -106,6 +108,7 @@ constexpr const char* kDesignUsage =
 
 constexpr const char* kBenchUsage =
     "usage: vines bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
+    "                   [--schemes LIST] [--substeps LIST]\n"
     "                   [--baselines LIST | --no-baselines] [--min-time S] [--reference DIR]\n"
     "                   [--full-outputs] [--json] [--csv FILE]\n"
     "\n"
@@ -115,6 +118,10 @@ constexpr const char* kBenchUsage =
     "  --rates LIST    sensor rates [Hz], comma-separated (default: the scene's)\n"
     "  --rtols LIST    contact sub-step tolerances (default: the scene's)\n"
     "  --scalars LIST  double,float (default: the scene's scalar)\n"
+    "  --schemes LIST  contact schemes: adaptive (a line per --rtols), bounded (a line per\n"
+    "                  --substeps) (default: the scene's loop.contact_scheme)\n"
+    "  --substeps LIST bounded scheme: sub-step budgets per sensor step, integers in\n"
+    "                  [2, 64] (default: the scene's loop.bounded_substeps)\n"
     "  --baselines LIST  SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the\n"
     "                  record's own points (default 1e-6,1e-8,1e-10; none with --json)\n"
     "  --no-baselines  no CVODE lines\n"
@@ -231,10 +238,15 @@ int cmd_run(const std::vector<std::string>& args) {
     }
     // Limits the loop ran into are reported, never silent (even with --quiet).
     const auto& k = j["counters"];
-    if (k["substep_cap_hits"].get<long long>() > 0)
+    const vines::LoopParams& loop = scene.params.loop;
+    if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kAdaptive)
       std::fprintf(stderr, "vines run: warning: %lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): "
                    "contacts in them are not resolved\n",
-                   k["substep_cap_hits"].get<long long>(), scene.params.loop.max_substeps_per_step);
+                   k["substep_cap_hits"].get<long long>(), loop.max_substeps_per_step);
+    if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kBounded)
+      std::fprintf(stderr, "vines run: warning: in %lld steps the sub-step budget (loop.bounded_substeps = %d) "
+                   "could not follow every event: they were deferred to the next step or stepped over\n",
+                   k["substep_cap_hits"].get<long long>(), loop.bounded_substeps);
     if (k["divergences_rolled_back"].get<long long>() + k["bad_samples_held"].get<long long>() > 0)
       std::fprintf(stderr, "vines run: warning: %lld diverging steps rolled back, %lld non-finite samples held\n",
                    k["divergences_rolled_back"].get<long long>(), k["bad_samples_held"].get<long long>());
@@ -363,6 +375,22 @@ int cmd_bench(const std::vector<std::string>& args) {
       else if (a == "--rtols") opt.rtols = xs;
       else if (a == "--baselines") opt.baseline_rtols = xs, baselines_given = true;
       else opt.min_time_s = xs[0];
+    } else if (a == "--substeps") {
+      if (!number_list(v, &xs)) return usage_error(kBenchUsage, a + ": not a list of positive numbers: " + v);
+      for (double x : xs) {
+        if (x != std::floor(x) || x < vines::kMinBoundedSubsteps || x > vines::kMaxBoundedSubsteps)
+          return usage_error(kBenchUsage, a + ": budgets must be integers in [2, 64]: " + v);
+        opt.bounded_substeps.push_back(static_cast<int>(x));
+      }
+    } else if (a == "--schemes") {
+      for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
+        c = v.find(',', s);
+        if (c == std::string::npos) c = v.size();
+        const std::string name = v.substr(s, c - s);
+        if (name != "adaptive" && name != "bounded")
+          return usage_error(kBenchUsage, a + ": unknown contact scheme '" + name + "' (adaptive, bounded)");
+        opt.schemes.push_back(name);
+      }
     } else if (a == "--scalars") {
       for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
         c = v.find(',', s);

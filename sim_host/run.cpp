@@ -206,6 +206,7 @@ json run_scene(const Scene& scene, const RunOptions& opt) {
                    {"events", t.count.events},
                    {"substep_cap_hits", t.count.cap_hits},
                    {"max_substeps_in_a_step", t.count.max_substeps_in_step},
+                   {"max_events_in_a_step", t.count.max_events_in_step},
                    {"bad_samples_held", t.count.bad_samples},
                    {"divergences_rolled_back", t.count.divergences}};
   j["modal"] = modal_json(dev.info);

@@ -26,6 +26,7 @@
 //   [loop]    sensor_rate_hz, contact_rtol, max_substeps_per_step,
 //             contact_count_depth_m, energy_ledger (default false),
 //             floor_peaks (default true), divergence_limit_m,
+//             contact_scheme = "adaptive" | "bounded", bounded_substeps,
 //             scalar = "double" | "float"
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
 //
@@ -383,6 +384,10 @@ void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
   s.read("energy_ledger", &l->energy_ledger);
   s.read("floor_peaks", &l->floor_peaks);
   s.read("divergence_limit_m", &l->divergence_limit_m);
+  s.choose<ContactScheme>("contact_scheme",
+                          {{"adaptive", ContactScheme::kAdaptive}, {"bounded", ContactScheme::kBounded}},
+                          &l->contact_scheme);
+  s.read("bounded_substeps", &l->bounded_substeps);
   s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}}, scalar);
 }
 
@@ -466,7 +471,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   read_loop(Section(origin, root, "loop",
                     {"sensor_rate_hz", "contact_rtol", "max_substeps_per_step",
                      "contact_count_depth_m", "energy_ledger", "floor_peaks", "divergence_limit_m",
-                     "scalar"}),
+                     "contact_scheme", "bounded_substeps", "scalar"}),
             &p.loop, &scene.scalar);
 
   // The shared range checks, reported at the offending key's line.

@@ -46,6 +46,7 @@ struct Counters {
   std::int64_t max_substeps_in_step = 0;
   std::int64_t bad_samples = 0;   // non-finite ground samples, replaced by the last good one
   std::int64_t divergences = 0;   // steps rolled back by the divergence guard
+  std::int64_t max_events_in_step = 0;  // most events applied in one step (bounded scheme)
 };
 
 // What a step carries to the next besides the linear state: the VI NES

@@ -86,6 +86,17 @@ struct DeviceParams {
   VinesParams vines;
 };
 
+// How a sensor step in which the VI NES particle may touch a wall is
+// integrated (substep.hpp, substep_bounded.hpp).
+enum class ContactScheme : std::uint8_t {
+  kAdaptive,  // adaptive Dormand-Prince sub-steps to contact_rtol, events to rounding
+  kBounded,   // at most bounded_substeps sub-steps a step: worst-case work fixed by construction
+};
+
+// Range of loop.bounded_substeps (sub-steps a sensor step may take).
+inline constexpr int kMinBoundedSubsteps = 2;
+inline constexpr int kMaxBoundedSubsteps = 64;
+
 struct LoopParams {
   double sensor_rate_hz = 1000.0;
   // Contact sub-stepping (adaptive embedded Runge-Kutta inside a step).
@@ -101,6 +112,12 @@ struct LoopParams {
   // Divergence guard: a floor (or the TMD) farther than this from the ground
   // [m], or any non-finite state, rolls the step back (see sim.hpp).
   double divergence_limit_m = 100.0;
+  // Contact integration: the adaptive scheme (contact_rtol,
+  // max_substeps_per_step) or the bounded one, which takes at most
+  // bounded_substeps Dormand-Prince sub-steps in a sensor step whatever
+  // happens in it (substep_bounded.hpp).
+  ContactScheme contact_scheme = ContactScheme::kAdaptive;
+  int bounded_substeps = 6;
 };
 
 struct SceneParams {

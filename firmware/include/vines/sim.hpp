@@ -9,7 +9,8 @@
 //      (nothing but the common case) in a tight loop, any other in full;
 //      if so: adaptive Dormand-Prince sub-steps through the step, contact
 //      starts and ends located to rounding, capped per step (cap hits are
-//      counted);
+//      counted); or, with loop.contact_scheme = kBounded, at most
+//      loop.bounded_substeps aimed sub-steps (substep_bounded.hpp);
 //   3. guards (non-finite input held, diverging steps rolled back), counters.
 // Work per step is bounded; no heap, no exceptions. run() feeds a block of
 // samples: the same steps, with runs of plain exact steps taken in blocks
@@ -25,6 +26,7 @@
 #include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
 #include "vines/substep.hpp"
+#include "vines/substep_bounded.hpp"
 
 namespace vines {
 
@@ -382,7 +384,8 @@ VINES_INLINE void step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a1) {
       // if it diverged (rare steps: the copy is affordable here).
       detail::close_elastic_run(m, d);
       const Data<S, N, Dev> before = d;
-      substep_through(m, d, a0, a1);
+      if (m.loop.contact_scheme == ContactScheme::kBounded) substep_bounded(m, d, a0, a1);
+      else substep_through(m, d, a0, a1);
       detail::refresh_floors(m, d);
       if (detail::diverged(m, d.z, d.xf, d.s, d.sd)) {
         const Counters count = d.count;

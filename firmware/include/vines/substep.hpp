@@ -189,15 +189,16 @@ struct SubStepper {
 }  // namespace detail
 
 // Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending at t1
-// within the run): peaks, contact depth.
+// within the run): peaks (per floor too, if floors and the loop keeps
+// them), contact depth.
 template <typename S, int N, typename Dev, typename Vec>
 void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0, const Vec& y1, S h,
-                   double t1) {
+                   double t1, bool floors = true) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   const auto z0 = y0.template head<NX>();
   const auto z1 = y1.template head<NX>();
   detail::update_top_peak_cubic(d, m.top_x(z0), m.top_v(z0), m.top_x(z1), m.top_v(z1), h, t1);
-  if (m.loop.floor_peaks)
+  if (floors && m.loop.floor_peaks)
     detail::update_peaks<S, N>(m.floor_x(z0), m.floor_v(z0), m.floor_x(z1), m.floor_v(z1), h, d.peak_x,
                                d.peak_drift);
   if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
@@ -208,9 +209,11 @@ void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, con
   }
 }
 
-// What happens at a located event (side: -1 left wall, +1 right wall).
+// What happens at a located event (side: -1 left wall, +1 right wall). A
+// contact ends where q reaches zero if the walls overlap by no more than
+// end_tol there (else q goes back on the overlap, below).
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
+void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side, S end_tol) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   using VecX = typename Model<S, N, Dev>::VecX;
   const auto& dm = m.dev;
@@ -265,7 +268,7 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
       // and the overlap drifted apart): then q goes back on the overlap.
       const S r = st.rel_pos(y);
       const S dl = st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
-      if (dl > m.dev.event_tol) {
+      if (dl > end_tol) {
         y(Stepper::kQ) = std::sqrt(std::sqrt(dl));
         break;
       }
@@ -277,6 +280,12 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
       st.mode = Mode::kFree;
       break;
   }
+}
+
+// The same, with the event tolerance for the end of a contact.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
+  apply_event(m, d, st, y, side, m.dev.event_tol);
 }
 
 // An event due right now, before any time passes: 0 if none, else the wall
@@ -313,6 +322,72 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   }
 }
 
+namespace detail {
+
+// Event function of the stepper's mode for the state y (f: its derivative),
+// crossing zero upwards at the event; *slope its derivative. side -1, +1:
+// the wall (free), or the mode's event (contact: q returns to zero; riding
+// a wall: the holding force changes sign); side 0 in a contact: the end of
+// the sensor step (t = h).
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+VINES_INLINE S event_value(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y, const Vec& f, int side, S h,
+                           S* slope) {
+  constexpr int kT = Stepper::kT, kQ = Stepper::kQ;
+  const auto& dm = m.dev;
+  if (side == 0) {
+    *slope = f(kT);
+    return y(kT) - h;
+  }
+  const S r = st.rel_pos(y), rd = st.rel_vel(y);
+  switch (st.mode) {
+    case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
+      *slope = side < 0 ? -rd : rd;
+      return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - m.dev.event_tol;
+    case Mode::kContactLeft:  // q returns to zero
+    case Mode::kContactRight:
+      *slope = -f(kQ);
+      return -y(kQ);
+    default: {  // stuck: the holding force changes sign
+      S fp, loss;
+      st.force(y, &fp, &loss);
+      *slope = S(0);
+      return st.mode == Mode::kStuckLeft ? -fp : fp;
+    }
+  }
+}
+
+// Does an event happen inside the sub-step from (y0, f0) to (y1, f1), of
+// length hs? Which first? From the cubic Hermite interpolant of each event
+// function (linear for the holding force, whose slope is not known): true
+// and *theta (the fraction of the sub-step: the first up-crossing on the
+// cubic, bisected `halvings` times after a 16-point grid), *side; false if
+// none.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y0, const Vec& f0,
+                              const Vec& y1, const Vec& f1, S hs, S h, int halvings, S* theta, int* side) {
+  const bool reg = st.regular();
+  bool any = false;
+  for (int sd = -1; sd <= 1; ++sd) {
+    if (sd == 0 && !reg) continue;           // t = h: only in w
+    if (st.mode != Mode::kFree && sd == 1) break;
+    S s0, s1;
+    const S g0 = event_value(m, st, y0, f0, sd, h, &s0), g1 = event_value(m, st, y1, f1, sd, h, &s1);
+    const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
+    const bool stuck = st.mode == Mode::kStuckLeft || st.mode == Mode::kStuckRight;
+    const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
+    if (!hit || g0 > S(0)) continue;
+    const S th = stuck ? g0 / (g0 - g1) : cub.first_upcrossing(halvings);
+    if (!any || th < *theta) {
+      *theta = th;
+      *side = sd;
+      any = true;
+    }
+  }
+  return any;
+}
+
+}  // namespace detail
+
 // Sub-stepped step from the current state to the next sample a1. The
 // independent variable u is t outside contacts and w inside (see the top).
 template <typename S, int N, typename Dev>
@@ -346,29 +421,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   int n = 0;
   bool capped = false;
   ++d.count.careful_steps;
-  // Event function of the current mode: crosses zero upwards at the event.
-  // Side 0 in a contact: the end of the sensor step (t = h).
+  // Event function of the current mode (detail::event_value).
   auto event_value = [&](const Vec& yy, const Vec& ff, int side, S* slope) {
-    if (side == 0) {
-      *slope = ff(kT);
-      return yy(kT) - h;
-    }
-    const S r = st.rel_pos(yy), rd = st.rel_vel(yy);
-    switch (st.mode) {
-      case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
-        *slope = side < 0 ? -rd : rd;
-        return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - event_tol;
-      case Mode::kContactLeft:  // q returns to zero
-      case Mode::kContactRight:
-        *slope = -ff(kQ);
-        return -yy(kQ);
-      default: {  // stuck: the holding force changes sign
-        S fp, loss;
-        st.force(yy, &fp, &loss);
-        *slope = S(0);
-        return st.mode == Mode::kStuckLeft ? -fp : fp;
-      }
-    }
+    return detail::event_value(m, st, yy, ff, side, h, slope);
   };
 
   int immediate = 0;
@@ -407,28 +462,12 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     if (forced) capped = true;
 
     // Does an event happen inside this sub-step? Which first? (Not in a
-    // forced sub-step: past the cap, events wait for the next step.)
+    // forced sub-step: past the cap, events wait for the next step.) A first
+    // guess for the Newton steps below: 1/16 of the sub-step bisected 20
+    // times (6e-8 of it).
     S theta = S(2);
     int side = 0;
-    bool any = false;
-    for (int sd = -1; sd <= 1 && !forced; ++sd) {
-      if (sd == 0 && !reg) continue;           // t = h: only in w
-      if (st.mode != Mode::kFree && sd == 1) break;
-      S s0, s1;
-      const S g0 = event_value(y, f, sd, &s0), g1 = event_value(r.y, r.f, sd, &s1);
-      const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
-      const bool stuck = st.mode == Mode::kStuckLeft || st.mode == Mode::kStuckRight;
-      const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
-      if (!hit || g0 > S(0)) continue;
-      // A first guess for the Newton steps below: 1/16 of the sub-step
-      // bisected 20 times (6e-8 of it).
-      const S th = stuck ? g0 / (g0 - g1) : cub.first_upcrossing(20);
-      if (!any || th < theta) {
-        theta = th;
-        side = sd;
-        any = true;
-      }
-    }
+    const bool any = !forced && detail::first_event(m, st, y, f, r.y, r.f, hs, h, 20, &theta, &side);
 
     if (any && theta <= S(1)) {
       // Place the event on the true sub-step, bracket [0, hs], from the

@@ -116,6 +116,10 @@ inline ParamError validate(const LoopParams& l) {
     return {"loop.contact_count_depth_m", "must be >= 0"};
   if (!(std::isfinite(l.divergence_limit_m) && l.divergence_limit_m > 0.0))
     return {"loop.divergence_limit_m", "must be finite and > 0"};
+  if (l.contact_scheme != ContactScheme::kAdaptive && l.contact_scheme != ContactScheme::kBounded)
+    return {"loop.contact_scheme", "must be \"adaptive\" or \"bounded\""};
+  if (l.bounded_substeps < kMinBoundedSubsteps || l.bounded_substeps > kMaxBoundedSubsteps)
+    return {"loop.bounded_substeps", "must be in [2, 64] (sub-steps per sensor step)"};
   return {};
 }
 

@@ -75,6 +75,8 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
     w.f64(x);
   w.u8(c.comp_order);
   for (int i = 0; i < n; ++i) w.f64(c.drift_limit_m[i]);
+  w.u8(static_cast<std::uint8_t>(l.contact_scheme));
+  w.u8(static_cast<std::uint8_t>(l.bounded_substeps));
   return w.ok() ? w.size() : 0;
 }
 
@@ -130,6 +132,12 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
     *x = r.f64();
   c->comp_order = r.u8();
   for (int i = 0; i < n; ++i) c->drift_limit_m[i] = r.f64();
+  const std::uint8_t scheme = r.u8(), substeps = r.u8();
+  if (scheme > static_cast<std::uint8_t>(ContactScheme::kBounded) || substeps < kMinBoundedSubsteps ||
+      substeps > kMaxBoundedSubsteps)
+    return false;
+  l.contact_scheme = static_cast<ContactScheme>(scheme);
+  l.bounded_substeps = substeps;
   return r.done();
 }
 

@@ -13,8 +13,9 @@ struct Dopri5Result {
   Vec err;  // difference between the 5th- and 4th-order solutions
 };
 
-// rhs(t, y) -> y'. f0 is rhs(t, y0).
-template <typename Vec, typename Scalar, typename Rhs>
+// rhs(t, y) -> y'. f0 is rhs(t, y0). kError = false: no error estimate
+// (r.err left unset), for fixed-step use.
+template <typename Vec, bool kError = true, typename Scalar, typename Rhs>
 Dopri5Result<Vec> dopri5_step(const Rhs& rhs, Scalar t, const Vec& y0, const Vec& f0, Scalar h) {
   using S = Scalar;
   constexpr S a21 = S(1.0 / 5.0);
@@ -38,7 +39,7 @@ Dopri5Result<Vec> dopri5_step(const Rhs& rhs, Scalar t, const Vec& y0, const Vec
   Dopri5Result<Vec> r;
   r.y = y0 + h * (b1 * f0 + b3 * k3 + b4 * k4 + b5 * k5 + b6 * k6);
   r.f = rhs(t + h, r.y);
-  r.err = h * (e1 * f0 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * r.f);
+  if constexpr (kError) r.err = h * (e1 * f0 + e3 * k3 + e4 * k4 + e5 * k5 + e6 * k6 + e7 * r.f);
   return r;
 }
 

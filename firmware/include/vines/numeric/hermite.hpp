@@ -74,6 +74,16 @@ struct Cubic {
   }
 };
 
+// The cubic Hermite interpolant of a vector function on [0, h] (values y0,
+// y1 and derivatives f0, f1 at the ends) at theta = t / h (also outside [0, 1]).
+template <typename Vec, typename S>
+Vec hermite_point(const Vec& y0, const Vec& f0, const Vec& y1, const Vec& f1, S h, S th) {
+  const S th2 = th * th, th3 = th2 * th;
+  const S w0 = S(2) * th3 - S(3) * th2 + S(1), w1 = S(1) - w0;
+  const S d0 = (th3 - S(2) * th2 + th) * h, d1 = (th3 - th2) * h;
+  return w0 * y0 + w1 * y1 + d0 * f0 + d1 * f1;
+}
+
 // Largest |y| on [0, h] of the quintic through values, first and second
 // derivatives at both ends (accurate to h^6 for smooth y).
 template <typename S>
