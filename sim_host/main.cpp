@@ -162,8 +162,15 @@ constexpr const char* kHilUsage =
     "                    samples' stamps)\n"
     "  --duration S      first S seconds of the record only\n"
     "  --json            print one JSON object; --csv FILE: one row per step\n"
-    "  --timeout S       longest wait for the node (default 5); --deadline P: telemetry\n"
-    "                    due P sensor periods after its sample (default 1)\n"
+    "  --timeout S       longest wait for the node (default 5, 60 with QEMU); --deadline P:\n"
+    "                    telemetry due P sensor periods after its sample (default 1)\n"
+    "  --node N          host (default: `vines node`), qemu:cortex-m4f or qemu:cortex-m7 (the\n"
+    "                    board image in QEMU, float / double, instructions counted; build\n"
+    "                    the preset first), or the path of a node program\n"
+    "  --image ELF       the board image to run (default: build/TARGET/firmware/app/\n"
+    "                    vines_node_DEVICE.elf)\n"
+    "  --budget-ticks T  the node's deadline budget in its counter ticks (ns on the host,\n"
+    "                    25 MHz on a board; default one sensor period): overruns reported\n"
     "fault options (SPEC: a rate per sample from 0 to 1, or @K1,K2,... sample indices):\n"
     "  --drop SPEC  --corrupt SPEC  --duplicate SPEC  --reorder SPEC  --nonfinite SPEC\n"
     "  --late SPEC [--late-periods L (3)]   --stall SPEC [--stall-periods S (20)]\n"
@@ -425,9 +432,19 @@ int cmd_bench(const std::vector<std::string>& args) {
 
 // One line of the hil report.
 void print_hil(const nlohmann::json& j) {
-  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz\n", j["scene"].get<std::string>().c_str(),
+  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", j["scene"].get<std::string>().c_str(),
               j["mode"].get<std::string>().c_str(), j["clock"].get<std::string>().c_str(),
-              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>());
+              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>(),
+              j["node"].get<std::string>().c_str());
+  const auto& nd = j["node_deadline"];
+  std::printf("  node deadline monitor: %lld overruns of a %lld-tick budget, worst step %lld ticks (k %lld)",
+              nd["overruns"].get<long long>(), nd["budget_ticks"].get<long long>(), nd["worst_ticks"].get<long long>(),
+              nd["worst_k"].get<long long>());
+  if (j.contains("worst_step_instructions"))
+    std::printf("; %.0f instructions (median %.0f)", j["worst_step_instructions"].get<double>(),
+                j["median_step_instructions"].get<double>());
+  if (nd["stack_peak_bytes"].get<long long>() > 0) std::printf("; stack %lld B", nd["stack_peak_bytes"].get<long long>());
+  std::printf("\n");
   std::printf("  steps %lld of %lld, deadline misses %lld (deadline %.3g ms)", j["steps"].get<long long>(),
               j["samples"].get<long long>(), j["deadline_misses"].get<long long>(), 1e3 * j["deadline_s"].get<double>());
   if (!j["latency_us"].is_null())
@@ -495,7 +512,12 @@ int cmd_hil(const std::vector<std::string>& args) {
       else if (a == "--virtual-clock") opt.realtime = false;
       else if (a == "--mode") opt.mode = value();
       else if (a == "--csv") opt.csv = value();
-      else if (a == "--node") opt.node_command = value();
+      else if (a == "--node") {
+        const std::string& v = value();
+        if (v == "host" || v.rfind("qemu:", 0) == 0) opt.node = v;
+        else opt.node_command = v;
+      } else if (a == "--image") opt.image = value();
+      else if (a == "--budget-ticks") opt.budget_ticks = static_cast<std::uint32_t>(number(1, 4e9));
       else if (a == "--duration") opt.duration_s = number(1e-6, 1e6);
       else if (a == "--timeout") opt.timeout_s = number(0.01, 3600);
       else if (a == "--deadline") opt.deadline_periods = number(0.01, 1e6);

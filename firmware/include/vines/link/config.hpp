@@ -35,6 +35,9 @@ struct NodeConfig {
   // Hybrid:
   double comp_delay_s = 0;   // actuator delay compensated by extrapolating the command
   std::uint8_t comp_order = 2;  // polynomial order of that extrapolation (1-3)
+  // Deadline monitor: a step whose model work takes more than this many of
+  // the node's counter ticks is an overrun (0: one sensor period).
+  std::uint32_t budget_ticks = 0;
 };
 
 inline constexpr std::size_t kMaxConfigBlob = 1600;
@@ -75,6 +78,7 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
     w.f64(x);
   w.u8(c.comp_order);
   for (int i = 0; i < n; ++i) w.f64(c.drift_limit_m[i]);
+  w.u32(c.budget_ticks);
   return w.ok() ? w.size() : 0;
 }
 
@@ -130,6 +134,7 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
     *x = r.f64();
   c->comp_order = r.u8();
   for (int i = 0; i < n; ++i) c->drift_limit_m[i] = r.f64();
+  c->budget_ticks = r.u32();
   return r.done();
 }
 
