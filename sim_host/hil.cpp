@@ -195,7 +195,10 @@ class NodeLink {
         ++bad_frames_;
       }
     }
-    if (!open) throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) + ")");
+    // A node ends after answering STOP; before that, an exit is a failure.
+    if (!open && acked_ < delimiters_)
+      throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) + 
+                               ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
   }
 
   // Waits until the node has answered every frame sent (lock step).
