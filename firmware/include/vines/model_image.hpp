@@ -478,7 +478,8 @@ class Text {
     const char* k = device_text(kind);
     if (!k) return s("an unknown device (code ").u(kind).s(")");
     s(k);
-    if (kind != static_cast<std::uint8_t>(DeviceKind::kVines)) return *this;
+    if (kind != static_cast<std::uint8_t>(DeviceKind::kVines))
+      return law == kNoLaw ? *this : s(" (law code ").u(law).s(")");
     const char* l = law_text(law);
     if (!l) return s(" (law code ").u(law).s(")");
     return s(" (").s(l).s(")");
@@ -497,6 +498,33 @@ constexpr std::size_t image_bytes() {
   constexpr detail::Shape sh = detail::shape<S, N, Dev>();
   static_assert(sh.fits, "visit_fields: a Part does not fit its field");
   return kHeaderBytes + sh.body;
+}
+
+// The header of an image as written (for tools that describe an image; the
+// Loader checks it against its instance). false: fewer than kHeaderBytes or
+// no magic.
+struct HeaderInfo {
+  std::uint16_t version = 0;
+  std::uint8_t scalar = 0, scalar_bytes = 0;  // scalar: 0 double, 1 float
+  std::uint16_t stories = 0;
+  std::uint8_t device = 0, law = kNoLaw;      // DeviceKind, ContactLaw (kNoLaw: no VI NES)
+  std::uint32_t length = 0;                   // header + body
+  std::uint16_t fields = 0;
+  std::uint32_t layout = 0, crc = 0;
+};
+inline bool read_header(const std::uint8_t* p, std::size_t n, HeaderInfo* out) {
+  if (p == nullptr || n < kHeaderBytes || std::memcmp(p, kMagic, 4) != 0) return false;
+  out->version = detail::get_u16(p + 4);
+  out->scalar = p[6];
+  out->scalar_bytes = p[7];
+  out->stories = detail::get_u16(p + 8);
+  out->device = p[10];
+  out->law = p[11];
+  out->length = detail::get_u32(p + 12);
+  out->fields = detail::get_u16(p + 16);
+  out->layout = detail::get_u32(p + 20);
+  out->crc = detail::get_u32(p + 24);
+  return true;
 }
 
 // Writes the image of a built model; returns its size, 0 if cap is too small.
