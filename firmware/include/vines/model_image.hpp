@@ -45,8 +45,11 @@
 //
 // Adding a field (another LoopParams or DeviceModel member): one line in
 // visit_fields at the marked spot; the size, field count and layout check
-// follow from it (a host and a node then need the same sources). Bump
-// kVersion when the meaning of existing fields changes.
+// follow from it (a host and a node then need the same sources). A member
+// added at the end of LoopParams or of the VI NES DeviceModel without its
+// line stops the build (static_assert tripwires naming the last member
+// carried: move them to the new one). Bump kVersion when the meaning of
+// existing fields changes.
 //
 // Firmware rules: header-only, no heap, no exceptions, no RTTI, no OS call;
 // the Loader holds a pointer to the model (keep the model static) and a few
@@ -226,6 +229,10 @@ constexpr void visit_fields(V& v) {
   v(all, &M::loop, &LoopParams::divergence_limit_m);
   // New LoopParams fields (e.g. a contact scheme) here, one line each:
   //   v(all, &M::loop, &LoopParams::new_field);
+  // Tripwire: a field added at the end of LoopParams without its line here
+  // stops the build (then name the new last field below).
+  static_assert(sizeof(LoopParams) == offsetof(LoopParams, divergence_limit_m) + sizeof(double),
+                "LoopParams has a field after divergence_limit_m: add its line to visit_fields");
 
   v(all, &M::h);
   v(all, &M::floor);
@@ -302,6 +309,10 @@ constexpr void visit_fields(V& v) {
       v(all, &M::dev, f);
     // New DeviceModel fields of the VI NES here, one line each:
     //   v(all, &M::dev, &DM::new_field);
+    // Tripwire, as for LoopParams (a field small enough to hide in the end
+    // padding of one scalar shows in the other).
+    static_assert(sizeof(DM) == (offsetof(DM, clear_hi) + sizeof(S) + alignof(DM) - 1) / alignof(DM) * alignof(DM),
+                  "DeviceModel (VI NES) has a field after clear_hi: add its line to visit_fields");
   }
 }
 
