@@ -245,8 +245,7 @@ constexpr void visit_fields(V& v) {
       v(modes, &M::lti, f);
   } else {
     v(all, &M::lti, &L::phi);
-    v(all, &M::lti, &L::a);
-    for (auto f : {&L::g0, &L::g1, &L::bg, &L::bf}) v(all, &M::lti, f);
+    for (auto f : {&L::g0, &L::g1}) v(all, &M::lti, f);
   }
   // Step integrals (E_e, input work, damping) and instantaneous forms.
   for (auto q : {&M::strain_step, &M::input_step, &M::damping_step}) {
@@ -698,6 +697,7 @@ class Loader {
   void start_body() {
     detail::Zeroer<Model<S, N, Dev>> z{m_};
     visit_fields<S, N, Dev>(z);
+#if VINES_MODEL_REPORT
     Model<S, N, Dev>& m = *m_;
     m.frame.m.setZero();
     m.frame.k.setZero();
@@ -710,6 +710,7 @@ class Loader {
       mo->m_eff.setZero();
       mo->phi.setZero();
     }
+#endif
     expected_crc_ = detail::get_u32(head_ + 24);
     crc_ = link::crc32(head_, 24);
     state_ = State::kBody;
