@@ -441,7 +441,10 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
       node = std::make_unique<NodeLink>(o, ++life, &faults, &fault_life);
       attach(*node);
       configure(*node, cfg, image);
-      start(*node, k, static_cast<std::uint64_t>(std::llround(seconds_since(t0) * 1e9)));
+      // The restarted node's clock starts where the bench's is: the wall
+      // clock in real time, the sample's due time on the virtual clock (the
+      // wall time there would make it hold every step up to it).
+      start(*node, k, static_cast<std::uint64_t>(std::llround((o.realtime ? seconds_since(t0) : due) * 1e9)));
       e->life = life;
       e->detected = node->first_cold_start();
     }
