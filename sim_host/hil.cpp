@@ -531,13 +531,15 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     auto& c = per_kind[fault_kind_name(e.kind)];
     c[0] += 1, c[1] += e.detected, c[2] += e.survived;
   }
-  // Saturation counts on samples that reach the node on time and intact (a
-  // clipped sample that is also dropped, late, ... is that other fault).
+  // Saturation counts on samples that reach the node on time and intact and
+  // that it stepped (a clipped sample that is also dropped, late, ... is that
+  // other fault; one in flight when its node was killed never arrived). The
+  // node sends a step's faults before its telemetry, on one ordered stream.
   for (const FaultEvent& e : events)
     for (long long j = e.k; j < e.k + (e.kind == FaultKind::kStall ? e.span : 1); ++j) clipped[j] = 0;
   long long clipped_n = 0, clipped_seen = 0;
-  for (long long k = 0; k < K; ++k) clipped_n += clipped[k];
-  for (const link::Fault& f : faults) clipped_seen += f.code == link::FaultCode::kSaturated && f.k < K && clipped[f.k];
+  for (long long k = 0; k < K; ++k) clipped_n += clipped[k] && got[k];
+  for (const link::Fault& f : faults) clipped_seen += f.code == link::FaultCode::kSaturated && f.k < K && clipped[f.k] && got[f.k];
   if (clipped_n > 0) {
     long long survived = 1;
     for (long long k = 0; k < K; ++k) survived &= !got[k] || finite(tel[k]);
