@@ -72,6 +72,15 @@ class Engine {
   virtual ~Engine() = default;
   // Builds the model; the parameters must fit this engine (see make_engine).
   virtual ParamError build(const SceneParams& p) = 0;
+  // The model's image (vines/model_image.hpp), after build() or load_image().
+  virtual std::vector<std::uint8_t> model_image() const = 0;
+  // Loads a model image in place of building: empty on success, after which
+  // init/step/run work as after build(); else why it was refused (the model
+  // held before is kept). An image carries no modal report: info() then has
+  // stories, sensor period, device floor and design, but zero frequencies,
+  // damping ratios, participation, effective masses, mode shapes and mass.
+  virtual std::string load_image(const std::uint8_t* p, std::size_t n) = 0;
+  // What the model knows (partial after load_image, see there).
   virtual ModelInfo info() const = 0;
   virtual void init(double a0) = 0;
   virtual void step(double a1) = 0;

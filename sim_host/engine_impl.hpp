@@ -3,9 +3,14 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "sim_host/engine.hpp"
+#include "vines/model_image.hpp"
 #include "vines/sim.hpp"
 
 namespace vines::host {
@@ -14,6 +19,23 @@ template <typename S, int N, typename Dev>
 class EngineImpl final : public Engine {
  public:
   ParamError build(const SceneParams& p) override { return build_model(p, model_.get()); }
+
+  std::vector<std::uint8_t> model_image() const override {
+    std::vector<std::uint8_t> out(image::image_bytes<S, N, Dev>());
+    out.resize(image::write_image(*model_, out.data(), out.size()));
+    return out;
+  }
+
+  std::string load_image(const std::uint8_t* p, std::size_t n) override {
+    // Into a fresh model, kept only if the image is accepted.
+    auto fresh = std::make_unique<Model<S, N, Dev>>();
+    image::Loader<S, N, Dev> loader(fresh.get());
+    const char* why = loader.push(p, n);
+    if (!why) why = loader.finish();
+    if (why) return why;
+    model_ = std::move(fresh);
+    return {};
+  }
 
   ModelInfo info() const override {
     const Model<S, N, Dev>& m = *model_;

@@ -31,12 +31,69 @@ using link::Telemetry;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// The model image of a node's configuration (model_image.hpp): what the
+// bench sends so that no node builds a model. Hybrid nodes build the bare
+// frame themselves (host only) and get none.
+std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what) {
+  if (cfg.mode == link::NodeMode::kHybrid) return {};
+  const Scalar scalar = cfg.scalar ? Scalar::kFloat : Scalar::kDouble;
+  std::unique_ptr<Engine> eng = make_engine(cfg.scene, scalar);
+  if (!eng) throw std::runtime_error(what + ": " + missing_engine(cfg.scene, scalar));
+  const ParamError e = eng->build(cfg.scene);
+  if (!e.ok()) throw std::runtime_error(what + ": " + e.field + ": " + e.message);
+  return eng->model_image();
+}
+
+// The board a "qemu:TARGET" node runs on: QEMU machine, scalar, and the
+// preset whose build holds its images.
+struct Board {
+  const char* target;
+  const char* machine;
+  Scalar scalar;
+};
+constexpr Board kBoards[] = {{"cortex-m4f", "mps2-an386", Scalar::kFloat}, {"cortex-m7", "mps2-an500", Scalar::kDouble}};
+// QEMU runs the boards with -icount shift=3: one instruction per 8 ns of
+// virtual time, so one tick of the 25 MHz counter is 5 instructions.
+constexpr int kIcountShift = 3;
+constexpr double kInstructionsPerTick = 40.0 / (1 << kIcountShift);
+
+const Board* board_of(const std::string& node) {
+  for (const Board& b : kBoards)
+    if (node == std::string("qemu:") + b.target) return &b;
+  return nullptr;
+}
+
+// The board image for a scene's device (firmware/app: one per device).
+std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) {
+  std::string dev;
+  const DeviceParams& d = sc.params.device;
+  if (d.kind == DeviceKind::kNone) dev = "none";
+  else if (d.kind == DeviceKind::kTmd) dev = "tmd";
+  else if (d.vines.law == ContactLaw::kKuwabara) dev = "vines";
+  else
+    throw std::runtime_error(sc.path + ": --node " + opt.node +
+                             ": the board images run the bare frame, the TMD and the VI NES with the Kuwabara law");
+  if (sc.params.frame.stories != 10)
+    throw std::runtime_error(sc.path + ": --node " + opt.node + ": the board images are built for 10 stories");
+  const std::string path = !opt.image.empty() ? opt.image
+                                              : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +
+                                                    "/firmware/app/vines_node_" + dev + ".elf";
+  std::ifstream f(path);
+  if (!f)
+    throw std::runtime_error("--node " + opt.node + ": no board image " + path + " (build it: cmake --preset " +
+                             b.target + " && cmake --build --preset " + b.target + ")");
+  return path;
+}
+
 // The offline run: the scene's engine stepped in this process, read exactly
 // as the node reads it (HostPlant), so equal code gives equal bits.
 std::vector<Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
                                    const std::string& what) {
   HostPlant plant;
   char msg[64] = {};
+  const std::vector<std::uint8_t> image = model_image(cfg, what);
+  plant.image_begin(static_cast<std::uint32_t>(image.size()));
+  plant.image_push(image.data(), image.size());
   if (!plant.configure(cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
   std::vector<Telemetry> out(samples.size());
   plant.init(samples[0], 0);
@@ -69,6 +126,12 @@ class NodeLink {
         child_(argv(opt)) {}
 
   static std::vector<std::string> argv(const HilOptions& opt) {
+    if (!opt.image.empty() && opt.node.rfind("qemu:", 0) == 0) {
+      const Board* b = board_of(opt.node);
+      return {"qemu-system-arm", "-M", b->machine, "-display", "none", "-monitor", "none",
+              "-semihosting-config", "enable=on,target=native", "-serial", "stdio",
+              "-icount", "shift=" + std::to_string(kIcountShift) + ",align=off,sleep=off", "-kernel", opt.image};
+    }
     std::vector<std::string> a = {opt.node_command.empty() ? self_exe() : opt.node_command, "node"};
     if (opt.realtime) a.push_back("--realtime");
     return a;
@@ -132,13 +195,18 @@ class NodeLink {
         ++bad_frames_;
       }
     }
-    if (!open) throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) + ")");
+    // A node ends after answering STOP; before that, an exit is a failure.
+    if (!open && acked_ < delimiters_)
+      throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) + 
+                               ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
   }
 
   // Waits until the node has answered every frame sent (lock step).
-  void wait_answered() {
+  // Waits until at most `in_flight` frames sent are still unanswered (0:
+  // lock step).
+  void wait_answered(std::uint32_t in_flight = 0) {
     const auto end = Clock::now() + std::chrono::duration<double>(opt_.timeout_s);
-    while (acked_ < delimiters_) {
+    while (acked_ + in_flight < delimiters_) {
       const double left = std::chrono::duration<double>(end - Clock::now()).count();
       if (left <= 0)
         throw std::runtime_error("node " + name_ + ": no answer within " + std::to_string(opt_.timeout_s) + " s to frame " +
@@ -173,17 +241,28 @@ class NodeLink {
   Clock::time_point t0_ = Clock::now();
 };
 
-// Configures a fresh node.
-void configure(NodeLink& node, const link::NodeConfig& cfg) {
-  std::uint8_t blob[link::kMaxConfigBlob];
-  const std::size_t n = link::encode(cfg, blob, sizeof blob);
-  if (n == 0) throw std::runtime_error("configuration does not fit the link");
-  const std::uint32_t crc = link::crc32(blob, n);
+// Sends one part of the configuration in chunks.
+void send_part(NodeLink& node, link::ConfigPart part, const std::uint8_t* bytes, std::size_t n) {
+  const std::uint32_t crc = link::crc32(bytes, n);
   for (std::size_t off = 0; off < n; off += link::kChunk) {
-    link::ConfigureChunk c{static_cast<std::uint16_t>(off), static_cast<std::uint16_t>(n), crc, blob + off,
+    link::ConfigureChunk c{part, static_cast<std::uint32_t>(off), static_cast<std::uint32_t>(n), crc, bytes + off,
                            static_cast<std::uint16_t>(std::min(link::kChunk, n - off))};
     node.send(node.encode(link::MsgType::kConfigure, c));
   }
+}
+
+// Configures a fresh node: the model image (if any), then the settings.
+void configure(NodeLink& node, const link::NodeConfig& cfg, const std::vector<std::uint8_t>& image) {
+  if (!image.empty()) {
+    send_part(node, link::ConfigPart::kModelImage, image.data(), image.size());
+    node.wait_answered();
+    if (node.status().message[0] != '\0')
+      throw std::runtime_error(std::string("node refused the model image: ") + node.status().message);
+  }
+  std::uint8_t blob[link::kMaxConfigBlob];
+  const std::size_t n = link::encode(cfg, blob, sizeof blob);
+  if (n == 0) throw std::runtime_error("configuration does not fit the link");
+  send_part(node, link::ConfigPart::kSettings, blob, n);
   node.wait_answered();
   if (node.status().state != link::NodeState::kConfigured)
     throw std::runtime_error(std::string("node refused the configuration: ") + node.status().message);
@@ -210,6 +289,7 @@ link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   c.residual_window_s = opt.residual_window_s;
   c.comp_delay_s = opt.comp_delay_s;
   c.comp_order = static_cast<std::uint8_t>(opt.comp_order);
+  c.budget_ticks = opt.budget_ticks;
   if (const char* why = link::validate_node(c)) throw std::runtime_error(why);
   return c;
 }
@@ -230,6 +310,22 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     throw std::runtime_error("--mode " + opt.mode + ": must be replay, twin or hybrid");
   Scene sc = scene;
   if (opt.duration_s > 0) sc.duration_s = opt.duration_s;
+  HilOptions o = opt;
+  const Board* board = nullptr;
+  if (o.node.rfind("qemu:", 0) == 0) {
+    board = board_of(o.node);
+    if (!board) throw std::runtime_error("--node " + o.node + ": must be host, qemu:cortex-m4f or qemu:cortex-m7");
+    if (o.mode == "hybrid")
+      throw std::runtime_error("--node " + o.node + ": hybrid mode runs on the host node only");
+    if (o.realtime)
+      throw std::runtime_error("--node " + o.node + ": QEMU counts instructions, not wall time: use the virtual clock");
+    o.image = board_image(o, *board, sc);
+    if (o.timeout_s <= 0) o.timeout_s = 60;  // QEMU boots, and takes ~20 kB/s
+    sc.scalar = board->scalar;  // the board's scalar, whatever the scene says
+  } else if (o.node != "host") {
+    throw std::runtime_error("--node " + o.node + ": must be host, qemu:cortex-m4f or qemu:cortex-m7");
+  }
+  if (o.timeout_s <= 0) o.timeout_s = 5;
   const Excitation ex = load_excitation(sc, "");
   const long long K = static_cast<long long>(ex.samples.size());
   const double h = 1.0 / sc.params.loop.sensor_rate_hz;
@@ -238,10 +334,10 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law "
                              "(hertz, tsuji or kuwabara): the table's load cell measures contact forces");
 
-  HilOptions o = opt;
   if (hybrid && o.comp_delay_s < 0) o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz);
   if (o.comp_delay_s < 0) o.comp_delay_s = 0;
   const link::NodeConfig cfg = node_config(sc, o);
+  const std::vector<std::uint8_t> image = model_image(cfg, sc.path);
 
   // What the node's telemetry is compared with: the offline run of the scene
   // (hybrid: the pure simulation, the device in the model).
@@ -303,7 +399,7 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     };
   };
   attach(*node);
-  configure(*node, cfg);
+  configure(*node, cfg, image);
   t0 = Clock::now();  // the bench clock starts with the run
   node->set_epoch(t0);
   start(*node, 0, 0);
@@ -318,6 +414,12 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     if (e && e->kind == FaultKind::kNonFinite) s.ag = k % 2 ? std::numeric_limits<double>::infinity() : std::nan("");
     return node->encode(link::MsgType::kSample, s);
   };
+  // Virtual clock: the node's clock is the samples' stamps, so a few frames
+  // may be under way at once without changing what it computes. A board in
+  // QEMU takes a byte per turn of QEMU's loop: a window of frames keeps its
+  // UART busy; the host node runs in strict lock step (its latency is
+  // measured per sample).
+  const std::uint32_t in_flight = board ? 16 : 0;
   std::multimap<long long, long long> releases;  // release at sample -> sample
   std::vector<std::uint8_t> reordered;            // frame held back by a reorder
   long long reordered_k = -1;
@@ -338,8 +440,11 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
       node->kill();
       node = std::make_unique<NodeLink>(o, ++life, &faults, &fault_life);
       attach(*node);
-      configure(*node, cfg);
-      start(*node, k, static_cast<std::uint64_t>(std::llround(seconds_since(t0) * 1e9)));
+      configure(*node, cfg, image);
+      // The restarted node's clock starts where the bench's is: the wall
+      // clock in real time, the sample's due time on the virtual clock (the
+      // wall time there would make it hold every step up to it).
+      start(*node, k, static_cast<std::uint64_t>(std::llround((o.realtime ? seconds_since(t0) : due) * 1e9)));
       e->life = life;
       e->detected = node->first_cold_start();
     }
@@ -378,7 +483,7 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
         if (kind == FaultKind::kDuplicate) node->send(f);
       }
     }
-    if (!o.realtime) node->wait_answered();
+    if (!o.realtime) node->wait_answered(in_flight);
   }
   for (auto& r : releases) node->send(sample_frame(r.second, static_cast<double>(K) * h));
   node->send(node->encode_empty(link::MsgType::kStop));
@@ -426,13 +531,15 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     auto& c = per_kind[fault_kind_name(e.kind)];
     c[0] += 1, c[1] += e.detected, c[2] += e.survived;
   }
-  // Saturation counts on samples that reach the node on time and intact (a
-  // clipped sample that is also dropped, late, ... is that other fault).
+  // Saturation counts on samples that reach the node on time and intact and
+  // that it stepped (a clipped sample that is also dropped, late, ... is that
+  // other fault; one in flight when its node was killed never arrived). The
+  // node sends a step's faults before its telemetry, on one ordered stream.
   for (const FaultEvent& e : events)
     for (long long j = e.k; j < e.k + (e.kind == FaultKind::kStall ? e.span : 1); ++j) clipped[j] = 0;
   long long clipped_n = 0, clipped_seen = 0;
-  for (long long k = 0; k < K; ++k) clipped_n += clipped[k];
-  for (const link::Fault& f : faults) clipped_seen += f.code == link::FaultCode::kSaturated && f.k < K && clipped[f.k];
+  for (long long k = 0; k < K; ++k) clipped_n += clipped[k] && got[k];
+  for (const link::Fault& f : faults) clipped_seen += f.code == link::FaultCode::kSaturated && f.k < K && clipped[f.k] && got[f.k];
   if (clipped_n > 0) {
     long long survived = 1;
     for (long long k = 0; k < K; ++k) survived &= !got[k] || finite(tel[k]);
@@ -457,7 +564,9 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
     // clock: its latency (sample handled to telemetry back) within the deadline.
     const double late = o.realtime ? arrival[k] - static_cast<double>(k) * h : arrival[k] - handled[k];
     latency_us.push_back(1e6 * (arrival[k] - handled[k]));
-    if (late > deadline) ++misses;
+    // A board in QEMU keeps the board's time, not the host's: its deadline is
+    // the step's cost on its counter against the budget (one period).
+    if (board ? tel[k].step_ticks > final_status.timing.budget_ticks : late > deadline) ++misses;
     all_finite = all_finite && finite(t);
     for (int i = 0; i < n; ++i) {
       max_dev = std::max(max_dev, std::fabs(t.x[i] - offline[k].x[i]));
@@ -489,7 +598,9 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
   j["samples"] = K;
   j["steps"] = steps;
   j["missing_steps"] = missing;
-  j["deadline_s"] = deadline;
+  j["deadline_s"] = board && final_status.timing.counter_hz
+                       ? static_cast<double>(final_status.timing.budget_ticks) / final_status.timing.counter_hz
+                       : deadline;
   j["deadline_misses"] = misses;
   j["latency_us"] = stats(latency_us);
   j["faults_injected"] = injected;
@@ -505,6 +616,26 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
   j["max_abs_floor_displacement_m"] = max_x;
   j["node_status"] = {{"steps", final_status.steps}, {"state", static_cast<int>(final_status.state)},
                       {"exit_status", node_exit}};
+  // The node's deadline monitor (its counter: ns on the host, the 25 MHz
+  // timer on a board) and each step's cost from telemetry.
+  const link::StepTiming& tm = final_status.timing;
+  j["node"] = o.node;
+  j["node_deadline"] = {{"counter_hz", tm.counter_hz},   {"budget_ticks", tm.budget_ticks},
+                        {"overruns", tm.overruns},       {"worst_ticks", tm.worst_ticks},
+                        {"worst_k", tm.worst_k},         {"stack_peak_bytes", tm.stack_peak_bytes}};
+  std::vector<double> ticks;
+  long long over = 0;
+  for (long long k = 0; k < K; ++k)
+    if (got[k]) ticks.push_back(tel[k].step_ticks), over += tel[k].step_ticks > tm.budget_ticks;
+  j["step_ticks"] = stats(ticks);
+  j["steps_over_budget"] = over;  // from telemetry: equals the monitor's overruns on a clean run
+  if (board && !ticks.empty()) {
+    std::sort(ticks.begin(), ticks.end());
+    j["icount_shift"] = kIcountShift;
+    j["worst_step_instructions"] = kInstructionsPerTick * tm.worst_ticks;
+    j["worst_step_k"] = tm.worst_k;
+    j["median_step_instructions"] = kInstructionsPerTick * ticks[ticks.size() / 2];
+  }
   j["wall_time_s"] = wall;
 
   if (twin) {

@@ -7,6 +7,7 @@
 // real-time hybrid simulation with an actuator and the VI NES on the table).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,7 @@ struct HilOptions {
   bool realtime = false;
   double duration_s = 0;        // 0: the scene's
   std::string csv;              // "" : none
-  double timeout_s = 5;         // longest wait for the node
+  double timeout_s = 0;         // longest wait for the node (0: 5 s, 60 s for a board in QEMU)
   double deadline_periods = 1;  // telemetry k due by (k + this) h
   unsigned long long seed = 1;
   FaultSpec faults[kFaultKinds];
@@ -51,7 +52,13 @@ struct HilOptions {
   double force_noise_n = 50, force_lsb_n = 10;
   double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
   int comp_order = 2;
-  std::string node_command;  // "" : this program's `node` command
+  // The node: "host" (this program's `vines node`), "qemu:cortex-m4f" or
+  // "qemu:cortex-m7" (the board image in QEMU, instructions counted), or the
+  // path of a program that speaks the link on stdin/stdout.
+  std::string node = "host";
+  std::string node_command;       // host node: the program run as `PROGRAM node` ("" : this one)
+  std::string image;              // qemu: the board image ("" : the preset build's)
+  std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
 };
 
 // Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.

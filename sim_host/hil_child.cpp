@@ -43,7 +43,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv) {
   if (pid_ == 0) {
     ::dup2(to_child[0], 0);
     ::dup2(from_child[1], 1);
-    ::execv(cargv[0], cargv.data());
+    ::execvp(cargv[0], cargv.data());
     _exit(127);
   }
   ::close(to_child[0]);

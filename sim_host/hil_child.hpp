@@ -13,7 +13,8 @@ namespace vines::host {
 
 class ChildProcess {
  public:
-  // Starts argv[0] with argv (throws std::runtime_error naming it on failure).
+  // Starts argv[0] (a path, or a program on PATH) with argv (throws
+  // std::runtime_error naming it on failure).
   explicit ChildProcess(const std::vector<std::string>& argv);
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;

@@ -18,6 +18,21 @@ link::ModalData modal_data(const ModelInfo& info) {
   return md;
 }
 
+// Far above any model image of the compiled frames (40 stories, double).
+constexpr std::uint32_t kMaxImageBytes = 1u << 24;
+
+const char* HostPlant::image_begin(std::uint32_t total) {
+  image_.clear();
+  if (total > kMaxImageBytes) return "model image: larger than any this node can hold";
+  image_.reserve(total);
+  return nullptr;
+}
+
+const char* HostPlant::image_push(const std::uint8_t* p, std::size_t n) {
+  image_.insert(image_.end(), p, p + n);
+  return nullptr;
+}
+
 bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap) {
   mode_ = c.mode;
   SceneParams p = c.scene;
@@ -28,6 +43,19 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     std::snprintf(msg, cap, "frame.stories: %s", missing_engine(p, scalar).c_str());
     return false;
   }
+  if (mode_ != link::NodeMode::kHybrid) {
+    if (image_.empty()) {
+      std::snprintf(msg, cap, "no model image: send it before the settings");
+      return false;
+    }
+    const std::string why = engine_->load_image(image_.data(), image_.size());
+    if (!why.empty()) {
+      std::snprintf(msg, cap, "%s", why.c_str());
+      return false;
+    }
+    n_ = p.frame.stories;
+    return true;
+  }
   const ParamError e = engine_->build(p);
   if (!e.ok()) {
     if (e.index >= 0) std::snprintf(msg, cap, "%s[%d]: %s", e.field, e.index, e.message);
@@ -35,7 +63,7 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     return false;
   }
   n_ = p.frame.stories;
-  if (mode_ == link::NodeMode::kHybrid) hybrid_.setup(modal_data(engine_->info()), 1.0 / p.loop.sensor_rate_hz);
+  hybrid_.setup(modal_data(engine_->info()), 1.0 / p.loop.sensor_rate_hz);
   return true;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include "sim_host/engine.hpp"
 #include "vines/link/config.hpp"
@@ -16,14 +17,22 @@ namespace vines::host {
 // The modal data of a bare frame, from a built engine's model info.
 link::ModalData modal_data(const ModelInfo& info);
 
+// The model image (model_image.hpp) is collected as it arrives and loaded
+// into the scene's engine at configure: the host node, like a board, runs
+// the model the bench built. Hybrid mode builds the bare frame from the
+// scene (it needs its modes) and takes no image.
 class HostPlant {
  public:
+  const char* image_begin(std::uint32_t total);
+  const char* image_push(const std::uint8_t* p, std::size_t n);
+  const char* image_finish() { return nullptr; }  // checked at configure, by the engine
   bool configure(const link::NodeConfig& c, char* msg, std::size_t cap);
   void init(double a0, double f0);
   void step(double a1, double f1);
   void read(link::Telemetry* t);
 
  private:
+  std::vector<std::uint8_t> image_;
   link::NodeMode mode_ = link::NodeMode::kReplay;
   int n_ = 0;
   std::unique_ptr<Engine> engine_;

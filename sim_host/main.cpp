@@ -1,4 +1,5 @@
 // vines: command-line front end of the VI NES firmware model.
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -17,13 +18,16 @@
 
 #include "sim_host/bench.hpp"
 #include "sim_host/design.hpp"
+#include "sim_host/engine.hpp"
 #include "sim_host/hil.hpp"
+#include "sim_host/names.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/stress.hpp"
 #include "sim_host/sweep.hpp"
 #include "sim_host/sweep_mpi.hpp"
+#include "vines/model_image.hpp"
 
 namespace {
 
@@ -63,6 +67,9 @@ constexpr const char* kUsage =
     "      link protocol (docs/link_protocol.md), streams the record at the sensor\n"
     "      rate, injects faults, checks deadlines and compares with the offline run;\n"
     "      digital-twin monitor and shake-table (hybrid) modes.\n"
+    "  image SCENE.toml [--scalar double|float] --out FILE\n"
+    "      Build the scene's model and write its model image: what a board loads\n"
+    "      instead of building the model itself (firmware/include/vines/model_image.hpp).\n"
     "  node [--realtime] [--idle-timeout S]\n"
     "      The firmware node on stdin/stdout (what `vines hil` runs).\n"
     "  help [COMMAND]\n"
@@ -169,8 +176,15 @@ constexpr const char* kHilUsage =
     "                    samples' stamps)\n"
     "  --duration S      first S seconds of the record only\n"
     "  --json            print one JSON object; --csv FILE: one row per step\n"
-    "  --timeout S       longest wait for the node (default 5); --deadline P: telemetry\n"
-    "                    due P sensor periods after its sample (default 1)\n"
+    "  --timeout S       longest wait for the node (default 5, 60 with QEMU); --deadline P:\n"
+    "                    telemetry due P sensor periods after its sample (default 1)\n"
+    "  --node N          host (default: `vines node`), qemu:cortex-m4f or qemu:cortex-m7 (the\n"
+    "                    board image in QEMU, float / double, instructions counted; build\n"
+    "                    the preset first), or the path of a node program\n"
+    "  --image ELF       the board image to run (default: build/TARGET/firmware/app/\n"
+    "                    vines_node_DEVICE.elf)\n"
+    "  --budget-ticks T  the node's deadline budget in its counter ticks (ns on the host,\n"
+    "                    25 MHz on a board; default one sensor period): overruns reported\n"
     "fault options (SPEC: a rate per sample from 0 to 1, or @K1,K2,... sample indices):\n"
     "  --drop SPEC  --corrupt SPEC  --duplicate SPEC  --reorder SPEC  --nonfinite SPEC\n"
     "  --late SPEC [--late-periods L (3)]   --stall SPEC [--stall-periods S (20)]\n"
@@ -183,6 +197,15 @@ constexpr const char* kHilUsage =
     "hybrid options: --actuator-hz F (20) --actuator-zeta Z (0.7) --actuator-delay S (0.005)\n"
     "  --force-noise N (50) --force-lsb N (10) --comp-delay S (default: delay + 2 zeta/w;\n"
     "  0: no compensation) --comp-order P (1-3, default 2)\n";
+
+constexpr const char* kImageUsage =
+    "usage: vines image SCENE.toml [--scalar double|float] --out FILE\n"
+    "\n"
+    "  Builds the scene's model on this host and writes its model image to FILE\n"
+    "  (format: firmware/include/vines/model_image.hpp); prints its size, version,\n"
+    "  scalar, stories, device and CRC. The record is not read.\n"
+    "  --scalar S   double or float (default: the scene's scalar)\n"
+    "  --out FILE   the image file to write\n";
 
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
@@ -253,6 +276,70 @@ int cmd_run(const std::vector<std::string>& args) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vines run: %s\n", e.what());
+    return 1;
+  }
+}
+
+int cmd_image(const std::vector<std::string>& args) {
+  using namespace vines::host;
+  std::string scene_path, out, scalar_arg;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kImageUsage, stdout);
+      return 0;
+    } else if (a == "--scalar" || a == "--out") {
+      if (i + 1 >= args.size()) return usage_error(kImageUsage, a + " needs a value");
+      (a == "--out" ? out : scalar_arg) = args[++i];
+      if (a == "--scalar" && scalar_arg != "double" && scalar_arg != "float")
+        return usage_error(kImageUsage, "--scalar takes double or float, got " + scalar_arg);
+      if (a == "--out" && out.empty()) return usage_error(kImageUsage, "--out needs a file name");
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error(kImageUsage, "unknown option " + a);
+    } else if (scene_path.empty()) {
+      scene_path = a;
+    } else {
+      return usage_error(kImageUsage, "more than one scene given");
+    }
+  }
+  if (scene_path.empty()) return usage_error(kImageUsage, "no scene given");
+  if (out.empty()) return usage_error(kImageUsage, "no --out FILE given");
+  try {
+    const Scene scene = load_scene(scene_path);
+    const Scalar scalar = scalar_arg.empty() ? scene.scalar : scalar_arg == "float" ? Scalar::kFloat : Scalar::kDouble;
+    const vines::SceneParams& p = scene.params;
+    std::unique_ptr<Engine> eng = make_engine(p, scalar);
+    if (!eng) throw std::runtime_error(scene.path + ": frame.stories: " + missing_engine(p, scalar));
+    const vines::ParamError e = eng->build(p);
+    if (!e.ok()) {
+      std::string key = e.field;
+      if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
+      throw std::runtime_error(scene.path + ": " + key + ": " + e.message);
+    }
+    const std::vector<std::uint8_t> img = eng->model_image();
+    vines::image::HeaderInfo h;
+    if (!vines::image::read_header(img.data(), img.size(), &h)) throw std::runtime_error("no image written");
+    // Checked writes: a short write or a failed close (disk full) is an error,
+    // and no partial image is left behind.
+    std::FILE* f = std::fopen(out.c_str(), "wb");
+    if (!f) throw std::runtime_error(out + ": cannot open for writing: " + std::strerror(errno));
+    const bool wrote = std::fwrite(img.data(), 1, img.size(), f) == img.size();
+    const int write_errno = errno;
+    const bool closed = std::fclose(f) == 0;
+    if (!wrote || !closed) {
+      const std::string why = std::strerror(wrote ? errno : write_errno);
+      std::error_code ec;
+      if (std::filesystem::is_regular_file(out, ec)) std::remove(out.c_str());
+      throw std::runtime_error(out + ": cannot write: " + why);
+    }
+    std::string device = device_name(p.device.kind);
+    if (p.device.kind == vines::DeviceKind::kVines) device += std::string(" (") + law_name(p.device.vines.law) + ")";
+    std::printf("image %s: %zu bytes, version %u, %s, %u stories, %s, CRC 0x%08x; written to %s\n",
+                scene.name.c_str(), img.size(), static_cast<unsigned>(h.version), h.scalar ? "float" : "double",
+                static_cast<unsigned>(h.stories), device.c_str(), static_cast<unsigned>(h.crc), out.c_str());
+    return 0;
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "vines image: %s\n", ex.what());
     return 1;
   }
 }
@@ -453,9 +540,19 @@ int cmd_bench(const std::vector<std::string>& args) {
 
 // One line of the hil report.
 void print_hil(const nlohmann::json& j) {
-  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz\n", j["scene"].get<std::string>().c_str(),
+  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", j["scene"].get<std::string>().c_str(),
               j["mode"].get<std::string>().c_str(), j["clock"].get<std::string>().c_str(),
-              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>());
+              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>(),
+              j["node"].get<std::string>().c_str());
+  const auto& nd = j["node_deadline"];
+  std::printf("  node deadline monitor: %lld overruns of a %lld-tick budget, worst step %lld ticks (k %lld)",
+              nd["overruns"].get<long long>(), nd["budget_ticks"].get<long long>(), nd["worst_ticks"].get<long long>(),
+              nd["worst_k"].get<long long>());
+  if (j.contains("worst_step_instructions"))
+    std::printf("; %.0f instructions (median %.0f)", j["worst_step_instructions"].get<double>(),
+                j["median_step_instructions"].get<double>());
+  if (nd["stack_peak_bytes"].get<long long>() > 0) std::printf("; stack %lld B", nd["stack_peak_bytes"].get<long long>());
+  std::printf("\n");
   std::printf("  steps %lld of %lld, deadline misses %lld (deadline %.3g ms)", j["steps"].get<long long>(),
               j["samples"].get<long long>(), j["deadline_misses"].get<long long>(), 1e3 * j["deadline_s"].get<double>());
   if (!j["latency_us"].is_null())
@@ -523,7 +620,12 @@ int cmd_hil(const std::vector<std::string>& args) {
       else if (a == "--virtual-clock") opt.realtime = false;
       else if (a == "--mode") opt.mode = value();
       else if (a == "--csv") opt.csv = value();
-      else if (a == "--node") opt.node_command = value();
+      else if (a == "--node") {
+        const std::string& v = value();
+        if (v == "host" || v.rfind("qemu:", 0) == 0) opt.node = v;
+        else opt.node_command = v;
+      } else if (a == "--image") opt.image = value();
+      else if (a == "--budget-ticks") opt.budget_ticks = static_cast<std::uint32_t>(number(1, 4e9));
       else if (a == "--duration") opt.duration_s = number(1e-6, 1e6);
       else if (a == "--timeout") opt.timeout_s = number(0.01, 3600);
       else if (a == "--deadline") opt.deadline_periods = number(0.01, 1e6);
@@ -830,6 +932,7 @@ int main(int argc, char** argv) {
   if (cmd == "reference") return cmd_reference(args);
   if (cmd == "stress") return cmd_stress(args);
   if (cmd == "hil") return cmd_hil(args);
+  if (cmd == "image") return cmd_image(args);
   if (cmd == "node") return vines::host::node_main(args);
   if (cmd == "help" || cmd == "-h" || cmd == "--help") {
     if (!args.empty() && args[0] == "run") std::fputs(kRunUsage, stdout);
@@ -839,6 +942,7 @@ int main(int argc, char** argv) {
     else if (!args.empty() && args[0] == "reference") std::fputs(kReferenceUsage, stdout);
     else if (!args.empty() && args[0] == "stress") std::fputs(kStressUsage, stdout);
     else if (!args.empty() && args[0] == "hil") std::fputs(kHilUsage, stdout);
+    else if (!args.empty() && args[0] == "image") std::fputs(kImageUsage, stdout);
     else std::fputs(kUsage, stdout);
     return 0;
   }

@@ -57,6 +57,26 @@ TEST(Hil, RealTimeRunKeepsPaceAndEqualsOffline) {
   EXPECT_GT(j["latency_us"]["mean"].get<double>(), 0.0);
 }
 
+// The node's deadline monitor reaches the report through STATUS: with a
+// budget of 1 ns every step overruns, and the counts agree with the steps'
+// own ticks in telemetry; with the default budget (one period, 1e6 ns on the
+// host) the worst step is the one telemetry shows.
+TEST(Hil, TheNodesDeadlineMonitorReachesTheReport) {
+  HilOptions o = base(0.5);
+  o.budget_ticks = 1;
+  const nlohmann::json j = run_hil(vines_scene(), o);
+  const auto& nd = j["node_deadline"];
+  EXPECT_EQ(j["node"], "host");
+  EXPECT_EQ(nd["counter_hz"].get<long long>(), 1000000000);
+  EXPECT_EQ(nd["budget_ticks"].get<long long>(), 1);
+  EXPECT_EQ(nd["overruns"].get<long long>(), 501);
+  EXPECT_EQ(j["steps_over_budget"].get<long long>(), 501);
+  const nlohmann::json d = run_hil(vines_scene(), base(0.5));
+  EXPECT_EQ(d["node_deadline"]["budget_ticks"].get<long long>(), 1000000);
+  EXPECT_EQ(d["node_deadline"]["worst_ticks"].get<double>(), d["step_ticks"]["max"].get<double>());
+  EXPECT_EQ(d["node_deadline"]["overruns"].get<long long>(), d["steps_over_budget"].get<long long>());
+}
+
 // Each kind at three samples: all detected and survived; the run stays
 // finite and bounded, and differs from the clean run.
 TEST(Hil, EveryFaultKindIsDetectedAndSurvived) {

@@ -121,8 +121,8 @@ TEST(HilNode, RefusesABadConfigurationNamingTheField) {
   const std::size_t n = link::encode(c, blob, sizeof blob);
   std::uint16_t seq = 0;
   for (std::size_t off = 0; off < n; off += link::kChunk) {
-    link::ConfigureChunk ch{static_cast<std::uint16_t>(off), static_cast<std::uint16_t>(n), link::crc32(blob, n),
-                            blob + off, static_cast<std::uint16_t>(std::min(link::kChunk, n - off))};
+    link::ConfigureChunk ch{link::ConfigPart::kSettings, static_cast<std::uint32_t>(off), static_cast<std::uint32_t>(n),
+                            link::crc32(blob, n), blob + off, static_cast<std::uint16_t>(std::min(link::kChunk, n - off))};
     const std::size_t w = link::encode_frame(link::MsgType::kConfigure, seq++, payload,
                                              link::encode(ch, payload, sizeof payload), wire, sizeof wire);
     node.write_all(wire, w, 5);

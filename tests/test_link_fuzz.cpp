@@ -19,20 +19,33 @@ void put(std::vector<std::uint8_t>* s, MsgType type, std::uint16_t seq, const st
   s->insert(s->end(), w, w + len);
 }
 
-// A valid session: configure (two chunks), start, samples, stop.
+// A valid session: a model image (two chunks; the toy plant takes any
+// bytes), the settings (two chunks), start, samples, stop.
 std::vector<std::uint8_t> session(std::mt19937& rng) {
   std::vector<std::uint8_t> s;
   NodeConfig c;
   c.scene.frame.stories = static_cast<int>(1 + rng() % kMaxStories);
+  for (int i = 0; i < c.scene.frame.stories; ++i) {
+    c.scene.frame.mass_kg[i] = 1e5;
+    c.scene.frame.stiffness_n_per_m[i] = 1e8;
+  }
   c.scene.loop.sensor_rate_hz = 1000;
   c.sensor_range_mps2 = 50;
   c.mode = static_cast<NodeMode>(rng() % 3);
   std::uint8_t blob[kMaxConfigBlob], p[kMaxPayload];
   const std::size_t n = encode(c, blob, sizeof blob);
   std::uint16_t seq = 0;
+  std::uint8_t image[300];
+  for (auto& b : image) b = static_cast<std::uint8_t>(rng());
+  for (std::size_t off = 0; off < sizeof image; off += kChunk) {
+    ConfigureChunk ch{ConfigPart::kModelImage, static_cast<std::uint32_t>(off), sizeof image,
+                      crc32(image, sizeof image), image + off,
+                      static_cast<std::uint16_t>(std::min(kChunk, sizeof image - off))};
+    put(&s, MsgType::kConfigure, seq++, p, encode(ch, p, sizeof p));
+  }
   for (std::size_t off = 0; off < n; off += kChunk) {
-    ConfigureChunk ch{static_cast<std::uint16_t>(off), static_cast<std::uint16_t>(n), crc32(blob, n), blob + off,
-                      static_cast<std::uint16_t>(std::min(kChunk, n - off))};
+    ConfigureChunk ch{ConfigPart::kSettings, static_cast<std::uint32_t>(off), static_cast<std::uint32_t>(n),
+                      crc32(blob, n), blob + off, static_cast<std::uint16_t>(std::min(kChunk, n - off))};
     put(&s, MsgType::kConfigure, seq++, p, encode(ch, p, sizeof p));
   }
   put(&s, MsgType::kStart, seq++, p, encode(Start{0, 0}, p, sizeof p));

@@ -1,51 +1,153 @@
 #!/usr/bin/python3
-"""Cost of the firmware on each MCU target, measured: instructions per step
-(El Centro, VI NES and TMD scenes, in QEMU with -icount), flash and RAM
-(arm-none-eabi-size), worst stack depth (the call graph of -fcallgraph-info=su
-plus every function's frame; cross-checked against the painted stack's
-high-water mark measured in the run).
+"""Cost of the firmware's link node on each MCU target, measured in QEMU:
+instructions per step (worst, median) over a workload of records and initial
+conditions, per contact scheme; flash and RAM (arm-none-eabi-size); stack
+(painted high-water mark from the runs, and the call-graph bound of
+-fcallgraph-info=su); the highest sensor rate the worst step sustains.
 
-  tools/mcu_report.py [--json] [--targets cortex-m4f,cortex-m7]
+  tools/mcu_report.py [--vines PATH] [--targets cortex-m4f,cortex-m7]
+                      [--schemes adaptive,bounded [--bounded-substeps N]]
+                      [--quick] [--duration S] [--full-scene] [--records GLOB]
+                      [--only scene,records,ics,tmd,bare] [--keep-scenes DIR]
+                      [-j N] [--json]
 
-Needs the presets built: cmake --build --preset release --target vines_feed
-(the host end of the link), cmake --build --preset cortex-m4f / cortex-m7.
---json prints one JSON object per target, one per line.
+Each run is `VINES hil SCENE --node qemu:TARGET --json --image ELF
+[--duration S]` (VINES: --vines, default build/release/vines) on a scene written
+to a temporary folder (--keep-scenes DIR: to DIR, kept). Per target (cortex-m4f: float, 1000 Hz sensor rate,
+168 MHz for the rate figure; cortex-m7: double, 2048 Hz, 480 MHz) and per
+mode (contact scheme), the VI NES runs are:
+  scene    data/scenes/elcentro_vines.toml as shipped (El Centro 2688-point,
+           0.3487 g, particle at rest against the left wall: u = -gap), at
+           the target's rate;
+  records  every file of the ground-motion folder (SOURCES.md skipped;
+           --records GLOB keeps the matching names) on the same scene,
+           rescaled to a PGA of 0.35 g (record.pga_g; format "auto", so a
+           multi-column file gives its first column after time);
+  ics      El Centro as in the scene, particle at u = -gap/2, 0, +gap/2 at
+           rest and u = 0 with v = +0.5 and -1.0 m/s (u = -gap at rest is the
+           scene run; gap read from `VINES run`'s summary of the scene);
+and once per target, not per mode: the TMD scene (elcentro_tmd.toml) and the
+bare frame (elcentro_bare.toml) at the target's rate. --only limits the
+kinds. --quick: the scene only, 3 s (or --duration). --duration S caps every
+run (vines hil --duration), except the scene run with --full-scene.
+Modes: without --schemes one mode, "default": no contact_scheme key is
+written and the build's own scheme runs. With --schemes each listed scheme
+is a mode: [loop] contact_scheme = "NAME" is written in the VI NES scenes
+(and bounded_substeps = N for "bounded" when --bounded-substeps is given);
+a build that refuses the key reports that mode's runs as failed, with
+vines' message.
+
+Figures, per target and mode (VI NES image, that mode's runs):
+  instructions_per_step_max     max over runs of worst_step_instructions (the
+                                node's deadline monitor, 25 MHz ticks x 5:
+                                QEMU -icount shift=3); its run's record,
+                                initial condition and step k beside it (k 0
+                                is the model's init on the first sample)
+  instructions_per_step_median  median step of the scene run (the El Centro
+                                reference workload); the range of the runs'
+                                medians beside it
+  flash_bytes   .isr_vector .text .ARM.extab .ARM.exidx .preinit_array
+                .init_array and .data's load image
+  ram_bytes     .data + .bss + .stack - __stack_guard_size: .stack
+                (mps2_sections.ld) is the 32 KiB no-access MPU guard at the
+                bottom of RAM, the process stack (__stack_size) and the
+                handler stack (__handler_stack_size); the guard holds no data
+                and is not counted (ram_bytes_with_guard includes it)
+  stack_bytes_max         painted high-water mark of the process stack
+                          (node_deadline.stack_peak_bytes), max over runs
+  stack_bytes_call_graph  worst path from vines_start through the .ci files
+                          (indirect calls, library code without call-graph
+                          info and alloca frames are not in it: listed)
+  max_sensor_rate_hz      clock / (1.5 x instructions_per_step_max), assuming
+                          1 instruction per cycle (QEMU counts instructions,
+                          not cycles: no pipeline, cache or memory timing)
+The TMD and bare-frame runs get the same figures under "tmd" and "bare".
+
+--json prints one JSON object per target, one per line: target, board,
+scalar, sensor_rate_hz, clock_hz, margin, duration_cap_s, images (per device:
+ELF, sizes, call-graph bound), modes (per mode: the figures above, worst_run,
+runs_ok, runs_failed, errors), tmd, bare, and runs (every run: kind, device,
+scheme, record, ic, duration_cap_s, steps, samples, worst, worst_k, median,
+overruns, stack_peak_bytes, max_deviation_from_offline, outputs_finite,
+wall_time_s, error; odd: anything unexpected, e.g. the image rebuilt
+during the report, so that the run's image is not the one sized). Progress
+goes to stderr.
+
+Exit status 0 if every run succeeded, 1 if a run failed (the others are
+still reported) or on a user error (missing vines or image: says what to
+build). Interrupted (Ctrl-C), it waits for the runs under way and reports
+the finished ones (status 130). Needs: the presets cortex-m4f / cortex-m7 built (images
+build/TARGET/firmware/app/vines_node_{none,tmd,vines}.elf), a host build of
+vines, qemu-system-arm, arm-none-eabi-size and -nm. Standard library only.
 """
 import argparse
+import concurrent.futures
+import fnmatch
 import glob
+import hashlib
 import json
+import math
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
+import threading
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TARGETS = {  # preset: board, scalar, clock for the sustained-rate figure
-    "cortex-m4f": ("mps2-an386", "float", 168e6),
-    "cortex-m7": ("mps2-an500", "double", 480e6),
+TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate figure
+    "cortex-m4f": ("mps2-an386", "float", 1000.0, 168e6),
+    "cortex-m7": ("mps2-an500", "double", 2048.0, 480e6),
 }
 MARGIN = 1.5  # the step must fit in 2/3 of the period
-IMAGES = ("vines", "tmd")
+DEVICES = ("none", "tmd", "vines")
+KINDS = ("scene", "records", "ics", "tmd", "bare")
+PGA_G = 0.35
+QUICK_DURATION_S = 3.0
+SCENES = os.path.join(ROOT, "data", "scenes")
 
 
 class Failure(Exception):
     pass
 
 
-def sizes(elf):
+# ---- images: sizes and call-graph stack bound -------------------------------
+
+def _tool(name, *args):
     try:
-        out = subprocess.run(["arm-none-eabi-size", "-A", elf], capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError) as e:
-        raise Failure(f"arm-none-eabi-size {elf}: {e}")
+        return subprocess.run([name, *args], capture_output=True, text=True, check=True).stdout
+    except OSError as e:
+        raise Failure(f"{name}: {e.strerror} (install the Arm GNU toolchain)")
+    except subprocess.CalledProcessError as e:
+        raise Failure(f"{name} {' '.join(args)}: {e.stderr.strip()}")
+
+
+def sizes(elf):
     sec = {}
-    for line in out.splitlines():
+    for line in _tool("arm-none-eabi-size", "-A", elf).splitlines():
         parts = line.split()
         if len(parts) == 3 and parts[0].startswith(".") and parts[1].isdigit():
             sec[parts[0]] = int(parts[1])
+    sym = {}
+    for line in _tool("arm-none-eabi-nm", elf).splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[2] in ("__stack_guard_size", "__stack_size", "__handler_stack_size"):
+            sym[parts[2]] = int(parts[0], 16)
     flash = sum(v for k, v in sec.items() if k in (
         ".isr_vector", ".text", ".ARM.extab", ".ARM.exidx", ".preinit_array", ".init_array", ".data"))
-    ram = sec.get(".data", 0) + sec.get(".bss", 0)
-    return flash, ram, sec.get(".stack", 0)
+    static = sec.get(".data", 0) + sec.get(".bss", 0)
+    stack_section = sec.get(".stack", 0)
+    guard = sym.get("__stack_guard_size", 0) if stack_section else 0
+    return {
+        "flash_bytes": flash,
+        "ram_bytes": static + stack_section - guard,
+        "ram_bytes_with_guard": static + stack_section,
+        "ram_static_bytes": static, "data_bytes": sec.get(".data", 0), "bss_bytes": sec.get(".bss", 0),
+        "stack_section_bytes": stack_section, "stack_guard_bytes": guard,
+        "process_stack_bytes": sym.get("__stack_size"), "handler_stack_bytes": sym.get("__handler_stack_size"),
+    }
 
 
 def call_graph(objdir):
@@ -82,100 +184,492 @@ def worst_stack(objdir, root="vines_start"):
         if fn in memo:
             return memo[fn]
         if fn not in frames:
-            unknown.add(fn)  # library code built without call-graph info
+            unknown.add(fn)  # library code built without call-graph info, or __indirect_call
         best = max((depth(c, path | {fn}) for c in edges.get(fn, ())), default=0)
         memo[fn] = frames.get(fn, 0) + best
         return memo[fn]
 
     total = depth(root, frozenset())
-    reached = set(memo)
-    return total, sorted(dynamic & reached), sorted(unknown), sorted(cycles)
+    return total, sorted(dynamic & set(memo)), sorted(unknown), sorted(cycles)
 
 
-def run_scene(target, board, scalar, device):
+def file_hash(path):
+    try:
+        with open(path, "rb") as f:
+            return hashlib.sha256(f.read()).hexdigest()[:16]
+    except OSError:
+        return None
+
+
+def image_info(target, device):
     build = os.path.join(ROOT, "build", target)
-    cmd = [sys.executable, os.path.join(ROOT, "hal", "mcu", "scene_run.py"), "--board", board,
-           "--image", os.path.join(build, "firmware", "app", f"vines_mcu_loop_{device}.elf"),
-           "--feed-tool", os.path.join(ROOT, "build", "release", "vines_feed"),
-           "--scene", os.path.join(ROOT, "data", "scenes", f"elcentro_{device}.toml"),
-           "--scalar", scalar, "--rtol", "1", "--count-rtol", "1e6", "--json"]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    elf = os.path.join(build, "firmware", "app", f"vines_node_{device}.elf")
+    info = {"elf": os.path.relpath(elf, ROOT), "sha256": file_hash(elf)}
+    info.update(sizes(elf))
+    total, dynamic, unknown, cycles = worst_stack(
+        os.path.join(build, "firmware", "app", "CMakeFiles", f"vines_node_{device}.dir"))
+    info.update({"stack_bytes_call_graph": total, "call_graph_dynamic_frames": dynamic,
+                 "call_graph_unanalysed_callees": unknown, "call_graph_cycles": cycles})
+    return info
+
+
+# ---- scenes -----------------------------------------------------------------
+
+def load_toml(path):
+    try:
+        import tomllib
+    except ImportError:
+        raise Failure("Python 3.11 or later is needed (tomllib)")
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except OSError as e:
+        raise Failure(f"{path}: {e.strerror}")
+    except tomllib.TOMLDecodeError as e:
+        raise Failure(f"{path}: {e}")
+
+
+def toml_value(v):
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise Failure(f"cannot write {v} in a scene")
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    raise Failure(f"cannot write {v!r} in a scene")
+
+
+def write_scene(path, scene):
+    lines = []
+    for table, keys in scene.items():
+        lines.append(f"[{table}]")
+        lines.extend(f"{k} = {toml_value(v)}" for k, v in keys.items())
+        lines.append("")
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def resolve_record(path, records_dir):
+    if os.path.isabs(path):
+        return path
+    for base in (SCENES, records_dir):
+        p = os.path.join(base, path)
+        if os.path.isfile(p):
+            return p
+    return path  # left to vines' own search (and its error)
+
+
+def base_scene(name, target, records_dir, scheme=None, bounded_substeps=None):
+    """A shipped scene at the target's rate and scalar, output trimmed."""
+    _, scalar, rate, _ = TARGETS[target]
+    sc = load_toml(os.path.join(SCENES, name))
+    sc = {t: dict(v) for t, v in sc.items()}
+    sc.setdefault("record", {})["path"] = resolve_record(sc["record"].get("path", ""), records_dir)
+    loop = sc.setdefault("loop", {})
+    loop["sensor_rate_hz"] = rate
+    loop["scalar"] = scalar  # the board's scalar wins anyway
+    if scheme is not None:
+        loop["contact_scheme"] = scheme
+        if scheme == "bounded" and bounded_substeps is not None:
+            loop["bounded_substeps"] = bounded_substeps
+    sc["output"] = {"rate_hz": rate, "timeseries": False}
+    return sc
+
+
+def vines_gap(vines, records_dir, tmp):
+    """The VI NES free travel (m) of the shipped scene, from `vines run`'s summary."""
+    sc = base_scene("elcentro_vines.toml", "cortex-m7", records_dir)
+    sc["record"]["duration_s"] = 0.01
+    path = os.path.join(tmp, "gap.toml")
+    write_scene(path, sc)
+    out = os.path.join(tmp, "gap_run")
+    r = subprocess.run([vines, "run", path, "--out", out], capture_output=True, text=True)
     if r.returncode != 0:
-        raise Failure(f"{target} {device}: scene run failed:\n{r.stderr.strip()}")
-    return json.loads(r.stdout)
+        raise Failure(f"{vines} run {path} (for the gap):\n{r.stderr.strip()}")
+    try:
+        with open(os.path.join(out, "summary.json")) as f:
+            return float(json.load(f)["device_params"]["gap_m"])
+    except (OSError, KeyError, TypeError, ValueError) as e:
+        raise Failure(f"no device_params.gap_m in {out}/summary.json ({e})")
 
 
-def report(target):
-    board, scalar, clock = TARGETS[target]
-    build = os.path.join(ROOT, "build", target)
-    elf = {d: os.path.join(build, "firmware", "app", f"vines_mcu_loop_{d}.elf") for d in IMAGES}
-    for path in elf.values():
-        if not os.path.isfile(path):
-            raise Failure(f"{path}: not built (cmake --preset {target} && cmake --build --preset {target})")
-    runs = {d: run_scene(target, board, scalar, d) for d in IMAGES}
-    flash, ram, stack_reserved = sizes(elf["vines"])
-    stacks = {d: worst_stack(os.path.join(build, "firmware", "app", "CMakeFiles", f"vines_mcu_loop_{d}.dir"))
-              for d in IMAGES}
-    # Worst of the call-graph bound and the painted measurement: the bound
-    # misses dynamic (alloca) frames and library code, the measurement only
-    # sees the paths this run took.
-    worst_of = {d: max(stacks[d][0], runs[d]["stack_peak_bytes"]) for d in IMAGES}
-    deepest = max(IMAGES, key=lambda d: worst_of[d])
-    _, dynamic, unknown, cycles = stacks[deepest]
-    stack = worst_of[deepest]
-    v, t = runs["vines"], runs["tmd"]
-    worst = max(r["all"]["max"] for r in runs.values())
-    return {
-        "target": target, "scalar": scalar, "board": board,
-        "instructions_per_step_max": worst,
-        "instructions_per_step_median": v["all"]["median"],
-        "flash_bytes": flash, "ram_bytes": ram, "stack_bytes_max": stack,
-        "stack_image": deepest, "stack_bytes_measured": runs[deepest]["stack_peak_bytes"],
-        "stack_bytes_by_image": {d: {"call_graph": stacks[d][0], "measured": runs[d]["stack_peak_bytes"]}
-                                 for d in IMAGES},
-        "stack_reserved_bytes": stack_reserved,
-        "stack_dynamic_frames": dynamic, "stack_unanalysed_callees": unknown, "stack_cycles": cycles,
-        "vines_free_steps": v["free"], "vines_contact_steps": v["contact"], "tmd_steps": t["all"],
-        "clock_hz": clock, "margin": MARGIN,
-        "max_sensor_rate_hz": clock / (MARGIN * worst),
-        "max_sensor_rate_hz_free_flight": clock / (MARGIN * max(v["free"]["max"], t["all"]["max"])),
-    }
+def ic_grid(gap):
+    """(label, position, velocity); u = -gap at rest is the scene run."""
+    return [("u=-gap/2 v=0", -gap / 2, 0.0), ("u=0 v=0", 0.0, 0.0), ("u=+gap/2 v=0", gap / 2, 0.0),
+            ("u=0 v=+0.5", 0.0, 0.5), ("u=0 v=-1.0", 0.0, -1.0)]
+
+
+SCENE_IC = "u=-gap v=0 (left wall)"
+
+
+def records_list(records_dir, pattern):
+    if not os.path.isdir(records_dir):
+        raise Failure(f"{records_dir}: no ground-motion folder (--records-dir, or $VINES_GROUND_MOTIONS)")
+    names = sorted(n for n in os.listdir(records_dir)
+                   if os.path.isfile(os.path.join(records_dir, n)) and n != "SOURCES.md")
+    if pattern:
+        globs = pattern.split(",")
+        names = [n for n in names if any(fnmatch.fnmatch(n, g) for g in globs)]
+        if not names:
+            raise Failure(f"--records {pattern}: no file of {records_dir} matches")
+    return names
+
+
+def plan(a, tmp, records_dir):
+    """Every run: (target, mode, kind, device, record, ic, scene path, cap)."""
+    kinds = ["scene"] if a.quick and not a.only else (a.only or list(KINDS))
+    cap = a.duration if a.duration else (QUICK_DURATION_S if a.quick else None)
+    modes = a.schemes or [None]
+    recs = records_list(records_dir, a.records) if "records" in kinds else []
+    gap = vines_gap(a.vines, records_dir, tmp) if "ics" in kinds else None
+    jobs = []
+
+    def add(target, mode, kind, scene, record, ic, run_cap, extra=None):
+        name = f"{len(jobs):03d}_{target}_{mode or 'default'}_{kind}"
+        path = os.path.join(tmp, name + ".toml")
+        scene.setdefault("scene", {})["name"] = name
+        write_scene(path, scene)
+        job = {"target": target, "scheme": mode or "default", "kind": kind,
+               "device": scene.get("device", {}).get("kind", "none"), "record": record, "ic": ic,
+               "scene_file": path, "duration_cap_s": run_cap}
+        job.update(extra or {})
+        jobs.append(job)
+
+    for target in a.targets:
+        for mode in modes:
+            vs = lambda: base_scene("elcentro_vines.toml", target, records_dir, mode, a.bounded_substeps)
+            scene_rec = os.path.basename(vs()["record"]["path"])
+            if "scene" in kinds:
+                add(target, mode, "scene", vs(), scene_rec, SCENE_IC, None if a.full_scene else cap)
+            for rec in recs:
+                sc = vs()
+                sc["record"] = {"path": os.path.join(records_dir, rec), "format": "auto", "pga_g": PGA_G}
+                add(target, mode, "records", sc, f"{rec} @{PGA_G} g", SCENE_IC, cap)
+            for label, u, v in (ic_grid(gap) if gap is not None else []):
+                sc = vs()
+                sc.setdefault("vines", {}).update({"initial_position_m": u, "initial_velocity_mps": v})
+                add(target, mode, "ics", sc, scene_rec, label, cap,
+                    {"initial_position_m": u, "initial_velocity_mps": v, "gap_m": gap})
+        for kind, name in (("tmd", "elcentro_tmd.toml"), ("bare", "elcentro_bare.toml")):
+            if kind in kinds:
+                sc = base_scene(name, target, records_dir)
+                add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap)
+    return jobs
+
+
+# ---- runs -------------------------------------------------------------------
+
+def image_for(job):
+    return os.path.join(ROOT, "build", job["target"], "firmware", "app", f"vines_node_{job['device']}.elf")
+
+
+def run_one(vines, job):
+    cmd = [vines, "hil", job["scene_file"], "--node", "qemu:" + job["target"], "--json",
+           "--image", image_for(job)]
+    if job["duration_cap_s"]:
+        cmd += ["--duration", repr(float(job["duration_cap_s"]))]
+    before = file_hash(image_for(job))
+    t0 = time.monotonic()
+    try:
+        r = subprocess.run(cmd, capture_output=True, text=True)
+    except OSError as e:
+        return {"error": f"{vines}: {e.strerror}"}
+    wall = time.monotonic() - t0
+    res = {"command": " ".join(cmd), "tool_wall_time_s": round(wall, 1), "image_sha256": before}
+    if file_hash(image_for(job)) != before:
+        res["image_rebuilt_during_run"] = True
+    if r.returncode != 0:
+        msg = r.stderr.strip() or r.stdout.strip() or f"exit status {r.returncode}"
+        res["error"] = msg
+        return res
+    try:
+        j = json.loads(r.stdout)
+    except ValueError:
+        res["error"] = "vines hil printed no JSON report: " + r.stdout[-300:] + r.stderr[-300:]
+        return res
+    nd = j.get("node_deadline", {})
+    if "worst_step_instructions" not in j:
+        res["error"] = "no worst_step_instructions in the report (not a board node?)"
+        return res
+    res.update({
+        "steps": j.get("steps"), "samples": j.get("samples"),
+        "worst": j["worst_step_instructions"], "worst_k": j.get("worst_step_k"),
+        "median": j.get("median_step_instructions"),
+        "overruns": nd.get("overruns"), "budget_ticks": nd.get("budget_ticks"),
+        "stack_peak_bytes": nd.get("stack_peak_bytes"), "step_ticks": j.get("step_ticks"),
+        "max_deviation_from_offline": j.get("max_deviation_from_offline"),
+        "outputs_finite": j.get("outputs_finite"), "missing_steps": j.get("missing_steps"),
+        "node_exit_status": j.get("node_status", {}).get("exit_status"),
+        "wall_time_s": j.get("wall_time_s"),
+    })
+    odd = []
+    if res.get("image_rebuilt_during_run"):
+        odd.append("the image changed during the run")
+    if j.get("outputs_finite") is False:
+        odd.append("non-finite output")
+    if j.get("steps") != j.get("samples"):
+        odd.append(f"{j.get('steps')} steps for {j.get('samples')} samples")
+    if j.get("missing_steps"):
+        odd.append(f"{j['missing_steps']} missing steps")
+    if res["node_exit_status"] not in (0, None):
+        odd.append(f"node exit status {res['node_exit_status']}")
+    if res["worst_k"] == 0:
+        odd.append("the worst step is the init (k 0)")
+    if odd:
+        res["odd"] = odd
+    return res
+
+
+def run_all(vines, jobs, workers):
+    # Longest first (samples to stream), for the pool's makespan.
+    def est(job):
+        return TARGETS[job["target"]][2] * (job["duration_cap_s"] or 60.0)
+    order = sorted(range(len(jobs)), key=lambda i: -est(jobs[i]))
+    lock, done = threading.Lock(), [0]
+    t_start = time.monotonic()
+
+    def work(i):
+        job = jobs[i]
+        res = run_one(vines, job)
+        job.update(res)
+        with lock:
+            done[0] += 1
+            what = f"{job['target']} {job['scheme']} {job['kind']} {job['record']} {job['ic']}"
+            if "error" in res:
+                first = res["error"].splitlines()[-1] if res["error"] else ""
+                line = f"FAILED: {first}"
+            else:
+                line = (f"worst {res['worst']:.0f} (k {res['worst_k']}), median {res['median']:.0f}, "
+                        f"{res['steps']} steps, {res['tool_wall_time_s']:.0f} s"
+                        + (f"; {'; '.join(res['odd'])}" if res.get("odd") else ""))
+            print(f"[{done[0]}/{len(jobs)} {time.monotonic() - t_start:6.0f} s] {what}: {line}",
+                  file=sys.stderr, flush=True)
+
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
+    futures = [pool.submit(work, i) for i in order]
+    try:
+        for f in futures:
+            f.result()
+    except KeyboardInterrupt:
+        # Report what finished: the runs under way end with their vines (which
+        # got the same SIGINT from the terminal), the others are not started.
+        print("mcu_report: interrupted; waiting for the runs under way, then reporting the finished ones",
+              file=sys.stderr, flush=True)
+        pool.shutdown(wait=True, cancel_futures=True)
+        for job in jobs:
+            if "worst" not in job and "error" not in job:
+                job["error"] = "not run (interrupted)"
+        return False
+    pool.shutdown()
+    return True
+
+
+# ---- figures ----------------------------------------------------------------
+
+def figures(runs, image, clock, reference_kind):
+    ok = [r for r in runs if "error" not in r]
+    errors = {}
+    for r in runs:
+        if "error" in r:  # the same refusal from every scene of a mode: once, with a count
+            e = re.sub(re.escape(r["scene_file"]) + r"(:\d+)?", "<scene>", r["error"])
+            errors[e] = errors.get(e, 0) + 1
+    out = {"runs_ok": len(ok), "runs_failed": len(runs) - len(ok),
+           "errors": [f"({n} run{'s' if n > 1 else ''}) {e}" for e, n in sorted(errors.items())]}
+    out.update({k: image[k] for k in ("flash_bytes", "ram_bytes", "ram_bytes_with_guard", "ram_static_bytes")})
+    out["stack_bytes_call_graph"] = image["stack_bytes_call_graph"]
+    if not ok:
+        return out
+    w = max(ok, key=lambda r: r["worst"])
+    ref = [r for r in ok if r["kind"] == reference_kind] or ok
+    medians = [r["median"] for r in ok]
+    out.update({
+        "instructions_per_step_max": w["worst"],
+        "worst_run": {k: w.get(k) for k in ("kind", "record", "ic", "worst_k", "duration_cap_s")},
+        "instructions_per_step_median": ref[0]["median"],
+        "median_of_run": {k: ref[0].get(k) for k in ("kind", "record", "ic", "duration_cap_s")},
+        "run_medians_min": min(medians), "run_medians_max": max(medians),
+        "stack_bytes_max": max(r["stack_peak_bytes"] or 0 for r in ok),
+        "steps_total": sum(r["steps"] or 0 for r in ok),
+        "overruns_total": sum(r["overruns"] or 0 for r in ok),
+        "max_sensor_rate_hz": clock / (MARGIN * w["worst"]),
+        "all_outputs_finite": all(r.get("outputs_finite") is True for r in ok),
+    })
+    return out
+
+
+def report(target, jobs, images, a):
+    board, scalar, rate, clock = TARGETS[target]
+    runs = [j for j in jobs if j["target"] == target]
+    modes = {}
+    for mode in (a.schemes or ["default"]):
+        mine = [r for r in runs if r["device"] == "vines" and r["scheme"] == mode]
+        if mine:
+            modes[mode] = figures(mine, images[(target, "vines")], clock, "scene")
+    rep = {"target": target, "board": board, "scalar": scalar, "sensor_rate_hz": rate, "clock_hz": clock,
+           "margin": MARGIN, "instructions_per_cycle_assumed": 1,
+           "duration_cap_s": a.duration if a.duration else (QUICK_DURATION_S if a.quick else None),
+           "full_scene": a.full_scene,
+           "images": {d: images[(target, d)] for d in DEVICES if (target, d) in images},
+           "modes": modes}
+    for kind, dev in (("tmd", "tmd"), ("bare", "none")):
+        mine = [r for r in runs if r["kind"] == kind]
+        if mine:
+            rep[kind] = figures(mine, images[(target, dev)], clock, kind)
+    keep = ("kind", "device", "scheme", "record", "ic", "initial_position_m", "initial_velocity_mps",
+            "duration_cap_s", "steps", "samples", "worst", "worst_k", "median", "overruns", "stack_peak_bytes",
+            "max_deviation_from_offline", "outputs_finite", "wall_time_s", "tool_wall_time_s", "odd", "error")
+    rep["runs"] = [{k: r[k] for k in keep if k in r} for r in runs]
+    for r, out in zip(runs, rep["runs"]):
+        # A build during the report: the run's image is not the one sized.
+        sized = images[(target, r["device"])]["sha256"]
+        if r.get("image_sha256") and r["image_sha256"] != sized:
+            out["image_sha256"] = r["image_sha256"]
+            out.setdefault("odd", []).append(f"image {r['image_sha256']}, not the one sized ({sized})")
+    return rep
+
+
+def fmt_block(name, f, clock):
+    lines = [f"  {name}: {f['runs_ok']} runs ok, {f['runs_failed']} failed"]
+    for e in f["errors"]:
+        lines.append("    error: " + e.replace("\n", "\n           "))
+    if "instructions_per_step_max" not in f:
+        return lines
+    w = f["worst_run"]
+    lines += [
+        f"    worst step      {f['instructions_per_step_max']:9.0f} instructions  "
+        f"({w['kind']}: {w['record']}, {w['ic']}, k {w['worst_k']})",
+        f"    median step     {f['instructions_per_step_median']:9.0f} instructions  "
+        f"({f['median_of_run']['kind']} run; runs' medians {f['run_medians_min']:.0f}-{f['run_medians_max']:.0f})",
+        f"    sustained rate  {f['max_sensor_rate_hz']:9.0f} Hz at {clock / 1e6:.0f} MHz "
+        f"(1 instruction/cycle assumed, {MARGIN:g}x margin on the worst step)",
+        f"    flash {f['flash_bytes']} B; RAM {f['ram_bytes']} B (static {f['ram_static_bytes']} B + stacks; "
+        f"{f['ram_bytes_with_guard']} B with the MPU guard)",
+        f"    stack           {f['stack_bytes_max']:9d} B painted (max over runs), "
+        f"{f['stack_bytes_call_graph']} B call-graph bound",
+        f"    {f['steps_total']} steps, {f['overruns_total']} over one sensor period (QEMU's clock); "
+        f"outputs finite: {f['all_outputs_finite']}",
+    ]
+    return lines
+
+
+def print_text(rep):
+    cap = rep["duration_cap_s"]
+    print(f"{rep['target']} ({rep['board']}, {rep['scalar']}, {rep['sensor_rate_hz']:g} Hz"
+          + (f", runs capped at {cap:g} s" + (" except the scene run" if rep["full_scene"] else "") if cap else "")
+          + ")")
+    for mode, f in rep["modes"].items():
+        print("\n".join(fmt_block(f"VI NES, mode {mode}", f, rep["clock_hz"])))
+    for kind, label in (("tmd", "TMD"), ("bare", "bare frame")):
+        if kind in rep:
+            print("\n".join(fmt_block(label, rep[kind], rep["clock_hz"])))
+    for d, im in rep["images"].items():
+        extra = []
+        if im["call_graph_dynamic_frames"]:
+            extra.append(f"{len(im['call_graph_dynamic_frames'])} dynamic frames")
+        if im["call_graph_unanalysed_callees"]:
+            u = im["call_graph_unanalysed_callees"]
+            extra.append("not followed: " + ", ".join(u[:6]) + (" ..." if len(u) > 6 else ""))
+        print(f"  image {d}: flash {im['flash_bytes']} B, .data {im['data_bytes']} + .bss {im['bss_bytes']} B, "
+              f".stack {im['stack_section_bytes']} B (guard {im['stack_guard_bytes']}, process "
+              f"{im['process_stack_bytes']}, handler {im['handler_stack_bytes']}); call graph "
+              f"{im['stack_bytes_call_graph']} B" + (f" ({'; '.join(extra)})" if extra else ""))
+    print("  runs:")
+    print(f"    {'kind':7s} {'scheme':9s} {'record':52s} {'initial condition':24s} {'steps':>7s} "
+          f"{'worst':>8s} {'k':>7s} {'median':>7s} {'over':>5s} {'stack':>6s} {'wall s':>7s}")
+    for r in rep["runs"]:
+        head = f"    {r['kind']:7s} {r['scheme']:9s} {r['record'][:52]:52s} {r['ic']:24s} "
+        if "error" in r:
+            print(head + "FAILED: " + r["error"].splitlines()[-1])
+            continue
+        print(head + f"{r['steps']:7d} {r['worst']:8.0f} {r['worst_k']:7d} {r['median']:7.0f} "
+              f"{r['overruns']:5d} {r['stack_peak_bytes']:6d} {r['tool_wall_time_s']:7.0f}"
+              + (f"  ({'; '.join(r['odd'])})" if r.get("odd") else ""))
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--json", action="store_true", help="one JSON object per target")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    ap.add_argument("--vines", default=os.path.join("build", "release", "vines"),
+                    help="the host build's vines (default build/release/vines)")
     ap.add_argument("--targets", default="cortex-m4f,cortex-m7")
+    ap.add_argument("--schemes", help="contact schemes, one mode each (e.g. adaptive,bounded); "
+                                      "default: the build's own, no key written")
+    ap.add_argument("--bounded-substeps", type=int, help="[loop] bounded_substeps for the bounded scheme")
+    ap.add_argument("--quick", action="store_true", help="El Centro scene only, 3 s (or --duration)")
+    ap.add_argument("--duration", type=float, help="cap every run at S seconds of record")
+    ap.add_argument("--full-scene", action="store_true", help="the El Centro scene run is not capped")
+    ap.add_argument("--records", help="glob(s), comma-separated, on the record file names")
+    ap.add_argument("--records-dir", help="ground-motion folder (default $VINES_GROUND_MOTIONS, "
+                                          "else ../shared/data/ground_motions beside the repository)")
+    ap.add_argument("--only", help="run kinds: " + ",".join(KINDS))
+    ap.add_argument("--keep-scenes", metavar="DIR", help="write the scenes to DIR and keep them "
+                                                            "(default: a temporary folder, removed)")
+    ap.add_argument("-j", dest="jobs", type=int, default=1, help="benches (QEMU) at once, default 1")
+    ap.add_argument("--json", action="store_true", help="one JSON object per target, one per line")
     a = ap.parse_args()
-    for target in a.targets.split(","):
-        if target not in TARGETS:
-            raise Failure(f"unknown target {target!r} (cortex-m4f or cortex-m7)")
-        r = report(target)
+
+    a.targets = [t for t in a.targets.split(",") if t]
+    for t in a.targets:
+        if t not in TARGETS:
+            raise Failure(f"unknown target {t!r} (cortex-m4f or cortex-m7)")
+    a.schemes = [s for s in a.schemes.split(",") if s] if a.schemes else None
+    if a.only:
+        a.only = [k for k in a.only.split(",") if k]
+        for k in a.only:
+            if k not in KINDS:
+                raise Failure(f"--only {k}: one of {', '.join(KINDS)}")
+    if a.duration is not None and not (a.duration > 0 and math.isfinite(a.duration)):
+        raise Failure("--duration must be > 0")
+    if a.jobs < 1:
+        raise Failure("-j must be >= 1")
+    if a.bounded_substeps is not None and a.bounded_substeps < 1:
+        raise Failure("--bounded-substeps must be >= 1")
+
+    vines = a.vines if os.path.isabs(a.vines) or os.path.exists(a.vines) else os.path.join(ROOT, a.vines)
+    if not (os.path.isfile(vines) and os.access(vines, os.X_OK)):
+        raise Failure(f"{a.vines}: no vines program (build it: cmake --preset release && "
+                      f"cmake --build --preset release --target vines; or pass --vines PATH)")
+    a.vines = os.path.abspath(vines)
+    if shutil.which("qemu-system-arm") is None:
+        raise Failure("qemu-system-arm not found (the boards run in QEMU)")
+    records_dir = a.records_dir or os.environ.get("VINES_GROUND_MOTIONS") or \
+        os.path.join(os.path.dirname(ROOT), "shared", "data", "ground_motions")
+
+    with tempfile.TemporaryDirectory(prefix="mcu_report_") as tmp:
+        if a.keep_scenes:
+            os.makedirs(a.keep_scenes, exist_ok=True)
+            tmp = os.path.abspath(a.keep_scenes)
+        jobs = plan(a, tmp, records_dir)
+        if not jobs:
+            raise Failure("nothing to run (--only / --records)")
+        missing = sorted({(j["target"], image_for(j)) for j in jobs if not os.path.isfile(image_for(j))})
+        if missing:
+            raise Failure("\n".join(f"{os.path.relpath(p, ROOT)}: not built (cmake --preset {t} && "
+                                    f"cmake --build --preset {t})" for t, p in missing))
+        images = {}
+        for t in a.targets:
+            for d in sorted({j["device"] for j in jobs if j["target"] == t}):
+                images[(t, d)] = image_info(t, d)
+        print(f"mcu_report: {len(jobs)} runs, {a.jobs} at once", file=sys.stderr, flush=True)
+        complete = run_all(a.vines, jobs, a.jobs)
+
+    failed = 0
+    for t in a.targets:
+        rep = report(t, jobs, images, a)
+        failed += sum(1 for r in rep["runs"] if "error" in r)
         if a.json:
-            print(json.dumps(r))
-            continue
-        print(f"{target} ({r['board']}, {r['scalar']}):")
-        for name, key in (("VI NES free-flight steps", "vines_free_steps"),
-                          ("VI NES contact steps", "vines_contact_steps"), ("TMD steps", "tmd_steps")):
-            c = r[key]
-            print(f"  {name:26s} {c['steps']:6d} steps, instructions/step max {c['max']:8.0f}, "
-                  f"median {c['median']:8.0f}")
-        print(f"  worst step {r['instructions_per_step_max']:.0f} instructions; at {r['clock_hz'] / 1e6:.0f} MHz, "
-              f"1 instruction/cycle, {r['margin']:g}x margin: up to {r['max_sensor_rate_hz']:.0f} Hz sensor rate "
-              f"({r['max_sensor_rate_hz_free_flight']:.0f} Hz without the contact steps)")
-        print(f"  flash {r['flash_bytes']} B, RAM {r['ram_bytes']} B static (+{r['stack_reserved_bytes']} B "
-              f"stacks reserved) (VI NES image)")
-        for d, st in r["stack_bytes_by_image"].items():
-            print(f"  stack, {d} image: {st['call_graph']} B worst path (call graph), {st['measured']} B "
-                  f"measured (painted stack; the model build at start-up is the deepest)")
-        if r["stack_dynamic_frames"]:
-            print(f"    frames of dynamic size (alloca; the measured figure covers them): "
-                  f"{len(r['stack_dynamic_frames'])}")
-        if r["stack_unanalysed_callees"]:
-            print(f"    callees without frame data (library code, counted 0): "
-                  f"{', '.join(r['stack_unanalysed_callees'][:8])}"
-                  f"{' ...' if len(r['stack_unanalysed_callees']) > 8 else ''}")
-    return 0
+            print(json.dumps(rep), flush=True)
+        else:
+            print_text(rep)
+    if failed:
+        print(f"mcu_report: {failed} run(s) failed or not run", file=sys.stderr)
+    return 130 if not complete else 1 if failed else 0
 
 
 if __name__ == "__main__":
@@ -184,3 +678,6 @@ if __name__ == "__main__":
     except Failure as e:
         print(f"mcu_report: {e}", file=sys.stderr)
         sys.exit(1)
+    except KeyboardInterrupt:
+        print("mcu_report: interrupted", file=sys.stderr)
+        sys.exit(130)

@@ -16,6 +16,17 @@ namespace vines::link::fuzz {
 struct ToyPlant {
   int n = 1;
   double a = 0, f = 0;
+  std::uint32_t image_bytes = 0;
+  const char* image_begin(std::uint32_t) {
+    image_bytes = 0;
+    return nullptr;
+  }
+  const char* image_push(const std::uint8_t*, std::size_t len) {
+    image_bytes += static_cast<std::uint32_t>(len);
+    return image_bytes > 4096 ? "model image: too long for the toy" : nullptr;
+  }
+  const char* image_finish() { return nullptr; }
+  void timing(StepTiming* t) const { t->counter_hz = 1; }
   bool configure(const NodeConfig& c, char* msg, std::size_t cap) {
     if (!(c.scene.loop.sensor_rate_hz > 0 && c.scene.loop.sensor_rate_hz <= 1e6)) {
       if (cap) msg[0] = '\0';

@@ -172,17 +172,18 @@ struct ModalForm {
 // ---------------------------------------------------------------- dense form
 
 template <typename S, int NX>
+// Only the exact step: the dense form carries the TMD, which has no contact
+// force (the sub-stepper's derivative and impulses are the modal form's), so
+// a board's RAM holds no continuous-time matrix.
 struct DenseLti {
   using VecX = Eigen::Matrix<S, NX, 1>;
-  Eigen::Matrix<S, NX, NX> phi, a;
-  VecX g0, g1, bg, bf;
+  Eigen::Matrix<S, NX, NX> phi;
+  VecX g0, g1;
 
   void step(VecX& z, S a0, S a1) const {
     const VecX z0 = z;  // lazyProduct reads z while it is written: no aliasing
     z = phi.lazyProduct(z0) + g0 * a0 + g1 * a1;
   }
-  VecX derivative(const VecX& z, S ag, S f) const { return a.lazyProduct(z) + bg * ag + bf * f; }
-  void impulse(VecX& z, S j) const { z += bf * j; }
 };
 
 template <typename S, int NX>
@@ -305,9 +306,6 @@ DenseLti<S, NX> discretise_dense(const LtiSpec<NX>& spec, double h) {
   out.phi = f.phi.template cast<S>();
   out.g0 = f.g0.template cast<S>();
   out.g1 = f.g1.template cast<S>();
-  out.a = spec.a.template cast<S>();
-  out.bg = spec.bg.template cast<S>();
-  out.bf = spec.bf.template cast<S>();
   return out;
 }
 

@@ -26,6 +26,15 @@ namespace vines {
 #define VINES_MODAL_LANES 1
 #endif
 
+// The reporting part of a model (the frame as simulated, its modes, the
+// nominal modes) is read by host summaries and by build_model, never by the
+// loop. A board that receives its model as an image (model_image.hpp)
+// compiles without it (VINES_MODEL_REPORT 0): it holds less RAM and cannot
+// build a model at all, which is the point.
+#ifndef VINES_MODEL_REPORT
+#define VINES_MODEL_REPORT 1
+#endif
+
 template <typename Dev, int N>
 struct Layout {
   static constexpr bool kModal = true;
@@ -92,10 +101,12 @@ struct Model {
   using QuadT = std::conditional_t<kModal, ModalQuad<S, kP>, DenseQuad<S, kNx>>;
   using FormT = std::conditional_t<kModal, ModalForm<S, kP>, DenseForm<S, kNx>>;
 
+#if VINES_MODEL_REPORT
   // Reporting (double): the frame as simulated, its modes, the nominal modes.
   Frame<N> frame;
   Modal<N> modal;
   Modal<N> nominal_modal;
+#endif
   LoopParams loop;
   double h = 0;          // sensor period [s]
   int floor = N - 1;     // device floor, 0-based
@@ -151,6 +162,7 @@ struct Model {
   }
 };
 
+#if VINES_MODEL_REPORT
 namespace detail {
 
 // Physical matrices over the P position coordinates: mass, frame stiffness,
@@ -366,5 +378,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   }
   return {};
 }
+
+#endif  // VINES_MODEL_REPORT
 
 }  // namespace vines

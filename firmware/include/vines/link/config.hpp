@@ -35,6 +35,9 @@ struct NodeConfig {
   // Hybrid:
   double comp_delay_s = 0;   // actuator delay compensated by extrapolating the command
   std::uint8_t comp_order = 2;  // polynomial order of that extrapolation (1-3)
+  // Deadline monitor: a step whose model work takes more than this many of
+  // the node's counter ticks is an overrun (0: one sensor period).
+  std::uint32_t budget_ticks = 0;
 };
 
 inline constexpr std::size_t kMaxConfigBlob = 1600;
@@ -77,6 +80,7 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
   for (int i = 0; i < n; ++i) w.f64(c.drift_limit_m[i]);
   w.u8(static_cast<std::uint8_t>(l.contact_scheme));
   w.u8(static_cast<std::uint8_t>(l.bounded_substeps));
+  w.u32(c.budget_ticks);
   return w.ok() ? w.size() : 0;
 }
 
@@ -138,6 +142,7 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
     return false;
   l.contact_scheme = static_cast<ContactScheme>(scheme);
   l.bounded_substeps = substeps;
+  c->budget_ticks = r.u32();
   return r.done();
 }
 

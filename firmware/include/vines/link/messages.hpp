@@ -17,9 +17,14 @@ namespace vines::link {
 
 inline constexpr std::size_t kChunk = 256;  // configuration bytes per frame
 
+// What a configuration chunk carries: the node's settings (config.hpp), or
+// the model image the host built (model_image.hpp), streamed to the plant.
+enum class ConfigPart : std::uint8_t { kSettings = 0, kModelImage = 1 };
+
 struct ConfigureChunk {
-  std::uint16_t offset = 0, total = 0;
-  std::uint32_t blob_crc = 0;  // CRC-32 of the whole blob
+  ConfigPart part = ConfigPart::kSettings;
+  std::uint32_t offset = 0, total = 0;
+  std::uint32_t blob_crc = 0;  // CRC-32 of the whole part
   const std::uint8_t* data = nullptr;
   std::uint16_t length = 0;
 };
@@ -64,6 +69,18 @@ struct Telemetry {
   double dissipated = 0; // energy dissipated in contacts so far [J] (energy ledger on)
   double aux = 0;        // twin: measured - predicted top acceleration; hybrid: command sent [m]
   std::uint64_t drift_alarms = 0;  // bit i: story i+1 beyond its limit
+  std::uint32_t step_ticks = 0;    // the model's work for this step, in the node's counter ticks
+};
+
+// The node's deadline monitor: every step's model work timed on the node's
+// counter and held against a budget (one sensor period unless configured).
+struct StepTiming {
+  std::uint32_t counter_hz = 0;    // ticks per second of the node's counter
+  std::uint32_t budget_ticks = 0;  // a step over this is an overrun
+  std::uint32_t overruns = 0;      // steps over the budget since START
+  std::uint32_t worst_ticks = 0;   // the longest step since START...
+  std::uint32_t worst_k = 0;       // ...and its sample index
+  std::uint32_t stack_peak_bytes = 0;  // deepest stack since power-up (0: unknown)
 };
 
 enum class NodeState : std::uint8_t { kBooted, kConfigured, kRunning, kStopped };
@@ -96,6 +113,7 @@ struct Status {
   std::uint32_t steps = 0;      // steps taken since boot
   std::uint32_t faults[kFaultCodes] = {};
   char message[64] = {};        // why a configuration was refused ("" if none)
+  StepTiming timing;            // the deadline monitor's counts
 };
 
 struct Fault {
@@ -109,21 +127,24 @@ struct Fault {
 
 inline std::size_t encode(const ConfigureChunk& c, std::uint8_t* b, std::size_t cap) {
   Writer w(b, cap);
-  w.u16(c.offset);
-  w.u16(c.total);
+  w.u8(static_cast<std::uint8_t>(c.part));
+  w.u32(c.offset);
+  w.u32(c.total);
   w.u32(c.blob_crc);
   w.bytes(c.data, c.length);
   return w.ok() ? w.size() : 0;
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, ConfigureChunk* c) {
   Reader r(p, n);
-  c->offset = r.u16();
-  c->total = r.u16();
+  const std::uint8_t part = r.u8();
+  c->offset = r.u32();
+  c->total = r.u32();
   c->blob_crc = r.u32();
-  if (!r.ok() || r.remaining() > kChunk) return false;
+  if (!r.ok() || r.remaining() > kChunk || part > static_cast<std::uint8_t>(ConfigPart::kModelImage)) return false;
+  c->part = static_cast<ConfigPart>(part);
   c->length = static_cast<std::uint16_t>(r.remaining());
   c->data = r.bytes(c->length);
-  return r.done() && c->offset + static_cast<std::size_t>(c->length) <= c->total;
+  return r.done() && static_cast<std::uint64_t>(c->offset) + c->length <= c->total;
 }
 
 inline std::size_t encode(const Start& s, std::uint8_t* b, std::size_t cap) {
@@ -168,6 +189,7 @@ inline std::size_t encode(const Telemetry& t, std::uint8_t* b, std::size_t cap) 
   for (double v : {t.acc_top, t.elastic_energy, t.particle_x, t.particle_v, t.contact_force, t.dissipated, t.aux})
     w.f64(v);
   w.u64(t.drift_alarms);
+  w.u32(t.step_ticks);
   return w.ok() && t.n <= kMaxStories ? w.size() : 0;
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, Telemetry* t) {
@@ -184,6 +206,7 @@ inline bool decode(const std::uint8_t* p, std::size_t n, Telemetry* t) {
                     &t->dissipated, &t->aux})
     *v = r.f64();
   t->drift_alarms = r.u64();
+  t->step_ticks = r.u32();
   return r.done();
 }
 
@@ -200,6 +223,8 @@ inline std::size_t encode(const Status& s, std::uint8_t* b, std::size_t cap) {
   while (len < sizeof s.message && s.message[len] != '\0') ++len;
   w.u8(static_cast<std::uint8_t>(len));
   w.bytes(reinterpret_cast<const std::uint8_t*>(s.message), len);
+  const StepTiming& t = s.timing;
+  for (std::uint32_t v : {t.counter_hz, t.budget_ticks, t.overruns, t.worst_ticks, t.worst_k, t.stack_peak_bytes}) w.u32(v);
   return w.ok() ? w.size() : 0;
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, Status* s) {
@@ -215,6 +240,9 @@ inline bool decode(const std::uint8_t* p, std::size_t n, Status* s) {
   const std::uint8_t len = r.u8();
   if (len >= sizeof s->message) return false;
   const std::uint8_t* m = r.bytes(len);
+  StepTiming& t = s->timing;
+  for (std::uint32_t* v : {&t.counter_hz, &t.budget_ticks, &t.overruns, &t.worst_ticks, &t.worst_k, &t.stack_peak_bytes})
+    *v = r.u32();
   if (!r.done()) return false;
   for (std::size_t i = 0; i < sizeof s->message; ++i) s->message[i] = i < len ? static_cast<char>(m[i]) : '\0';
   return true;

@@ -3,10 +3,16 @@
 // status and fault reports. Fixed memory, no heap, no exceptions: the same
 // code runs in the host's node process and on the microcontroller.
 //
-// Plant (duck-typed): bool configure(const NodeConfig&, char* msg, size_t cap);
+// Plant (duck-typed):
+//   const char* image_begin(uint32_t total); const char* image_push(const uint8_t*, size_t);
+//   const char* image_finish(): the model image, streamed in order (nullptr,
+//     or why it is refused: corrupt, truncated, built for another node);
+//   bool configure(const NodeConfig&, char* msg, size_t cap): the settings,
+//     checked against the model image (false with the reason in msg);
 //   void init(double a0, double f0); void step(double a1, double f1);
-//   void read(Telemetry*) (fills n, x, acc_top, energies, particle; flags
-//   kGuard when the core's guards acted in the last step).
+//   void read(Telemetry*) (fills n, x, acc_top, energies, particle,
+//     step_ticks; flags kGuard when the core's guards acted in the last step);
+//   void timing(StepTiming*) (the deadline monitor's counts).
 // Sink: void write(const uint8_t*, size_t).
 //
 // Fault policy (docs/link_protocol.md): frames are checked (COBS, CRC,
@@ -26,6 +32,7 @@
 #include "vines/link/extrapolate.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/validate.hpp"
 
 namespace vines::link {
 
@@ -164,6 +171,7 @@ class Node {
 
   void on_configure(const ConfigureChunk& c) {
     if (status_.state == NodeState::kRunning) return fault(FaultCode::kProtocol, 0, 1);
+    if (c.part == ConfigPart::kModelImage) return on_image(c);
     if (c.total > kMaxConfigBlob || (c.offset != 0 && (c.offset != blob_len_ || c.blob_crc != blob_crc_)))
       return fault(FaultCode::kConfig, c.offset, 1);
     if (c.offset == 0) blob_crc_ = c.blob_crc;
@@ -178,7 +186,9 @@ class Node {
     if (crc32(blob_, c.total) != c.blob_crc) why = "configuration blob: CRC mismatch";
     else if (!decode(blob_, c.total, &cfg)) why = "configuration blob: malformed";
     else why = validate_node(cfg);
+    const ParamError scene = why ? ParamError{} : validate(cfg.scene);
     if (why) copy_message(why);
+    else if (!scene.ok()) why = describe(scene);
     else if (!plant_->configure(cfg, status_.message, sizeof status_.message)) why = status_.message;
     if (why) {
       fault(FaultCode::kConfig, 0, 1);
@@ -187,6 +197,35 @@ class Node {
     cfg_ = cfg;
     h_ = 1.0 / cfg.scene.loop.sensor_rate_hz;
     status_.state = NodeState::kConfigured;
+    send_status();
+  }
+
+  // A chunk of the model image: streamed to the plant in order (it decodes
+  // into the model's own storage, so no buffer the size of the image). A
+  // refused image leaves the node unconfigured, with the reason.
+  void on_image(const ConfigureChunk& c) {
+    const char* why = nullptr;
+    if (c.offset == 0) {
+      status_.state = NodeState::kBooted;
+      status_.message[0] = '\0';
+      image_len_ = 0;
+      image_crc_ = c.blob_crc;
+      image_failed_ = false;
+      why = plant_->image_begin(c.total);
+    } else if (image_failed_) {
+      return;  // refused already: the rest of it is ignored
+    } else if (c.offset != image_len_ || c.blob_crc != image_crc_) {
+      why = "model image: chunks out of order or from another image";
+    }
+    if (!why) why = plant_->image_push(c.data, c.length);
+    image_len_ = c.offset + c.length;
+    if (!why && image_len_ == c.total) why = plant_->image_finish();
+    if (!why && image_len_ < c.total) return;
+    if (why) {
+      image_failed_ = true;
+      copy_message(why);
+      fault(FaultCode::kConfig, c.offset, 1);
+    }
     send_status();
   }
 
@@ -264,9 +303,9 @@ class Node {
 
     Telemetry& t = tel_;
     t = Telemetry{};
+    t.k = k;
     plant_->read(&t);
     t.rx = status_.rx;
-    t.k = k;
     t.ag = a;
     t.flags = static_cast<std::uint16_t>(t.flags | flags);
     if (cfg_.mode == NodeMode::kTwin) twin(&t, aux, (flags & kAuxMissing) == 0);
@@ -309,7 +348,10 @@ class Node {
     ++tx_frames_;
     sink_->write(wire, w);
   }
-  void send_status() { send(MsgType::kStatus, status_); }
+  void send_status() {
+    plant_->timing(&status_.timing);
+    send(MsgType::kStatus, status_);
+  }
   void fault(FaultCode code, std::uint32_t k, std::uint32_t count) {
     ++status_.faults[static_cast<int>(code)];
     Fault f;
@@ -318,6 +360,28 @@ class Node {
     f.k = k;
     f.count = count;
     send(MsgType::kFault, f);
+  }
+  // "field[index]: message" into the status message (no printf on a board).
+  const char* describe(const ParamError& e) {
+    char* m = status_.message;
+    const std::size_t cap = sizeof status_.message;
+    std::size_t n = 0;
+    auto put = [&](const char* s) {
+      for (; *s != '\0' && n + 1 < cap; ++s) m[n++] = *s;
+    };
+    put(e.field);
+    if (e.index >= 0) {
+      char digits[12];
+      int d = 0;
+      for (unsigned v = static_cast<unsigned>(e.index); d == 0 || v != 0; v /= 10) digits[d++] = static_cast<char>('0' + v % 10);
+      put("[");
+      while (d > 0 && n + 1 < cap) m[n++] = digits[--d];
+      put("]");
+    }
+    put(": ");
+    put(e.message);
+    m[n] = '\0';
+    return m;
   }
   void copy_message(const char* s) {
     std::size_t i = 0;
@@ -341,6 +405,9 @@ class Node {
   std::uint8_t blob_[kMaxConfigBlob] = {};
   std::size_t blob_len_ = 0;
   std::uint32_t blob_crc_ = 0;
+  // model image
+  std::uint32_t image_len_ = 0, image_crc_ = 0;
+  bool image_failed_ = false;
   // run
   bool initialised_ = false, stalled_ = false;
   std::uint64_t now_ = 0, local_ = 0, last_rx_ns_ = 0;  // bench clock now; local clock at the last byte

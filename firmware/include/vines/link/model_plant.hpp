@@ -1,0 +1,115 @@
+// The plant of a board's node (link/node.hpp): one compiled instance of the
+// core (scalar S, N stories, device Dev) whose model arrives as the image the
+// host built (model_image.hpp), decoded straight into static storage. The
+// board never builds a model: no eigensolver, no matrix exponential. Replay
+// and twin modes; hybrid mode (the bare frame driven by a table force) runs
+// on the host node.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "vines/link/config.hpp"
+#include "vines/link/messages.hpp"
+#include "vines/model_image.hpp"
+#include "vines/sim.hpp"
+
+namespace vines::link {
+
+template <typename S, int N, typename Dev>
+class ModelPlant {
+ public:
+  using ModelT = Model<S, N, Dev>;
+  using DataT = Data<S, N, Dev>;
+
+  // model and data: static storage of the application (they are large).
+  ModelPlant(ModelT* model, DataT* data) : model_(model), data_(data), loader_(model) {}
+
+  const char* image_begin(std::uint32_t /*total*/) {
+    configured_ = false;
+    loader_.reset();
+    return nullptr;
+  }
+  const char* image_push(const std::uint8_t* p, std::size_t n) { return loader_.push(p, n); }
+  const char* image_finish() { return loader_.finish(); }
+
+  // The settings must fit the image this node holds.
+  bool configure(const NodeConfig& c, char* msg, std::size_t cap) {
+    configured_ = false;
+    const char* why = check(c);
+    if (why) {
+      copy(why, msg, cap);
+      return false;
+    }
+    configured_ = true;
+    guard_events_ = 0;
+    return true;
+  }
+
+  void init(double a0, double /*f0*/) {
+    guard_events_ = 0;
+    vines::init(*model_, *data_, static_cast<S>(a0));
+  }
+  void step(double a1, double /*f1*/) { vines::step(*model_, *data_, static_cast<S>(a1)); }
+
+  // What the host node's plant reads (sim_host/hil_plant.cpp), from the same
+  // core functions.
+  void read(Telemetry* t) {
+    const ModelT& m = *model_;
+    const DataT& d = *data_;
+    const auto x = floor_displacements(m, d);
+    const auto acc = absolute_accel(m, d);
+    t->n = static_cast<std::uint8_t>(N);
+    for (int i = 0; i < N; ++i) t->x[i] = static_cast<double>(x(i));
+    t->acc_top = static_cast<double>(acc(N - 1));
+    t->elastic_energy = elastic_energy(m, d);
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      t->particle_x = static_cast<double>(m.dev.y0 + d.s);
+      t->particle_v = static_cast<double>(d.sd);
+      t->contact_force = static_cast<double>(d.contact_force);
+      t->contact_mode = static_cast<std::uint8_t>(d.mode);
+    }
+    t->dissipated = d.ledger.contact;
+    const std::int64_t guards = d.count.bad_samples + d.count.divergences;
+    if (guards != guard_events_) t->flags |= kGuard;
+    guard_events_ = guards;
+  }
+
+  bool configured() const { return configured_; }
+
+ private:
+  const char* check(const NodeConfig& c) const {
+    if (c.mode == NodeMode::kHybrid) return "mode hybrid: runs on the host node (vines node), not on this board";
+    if (!loader_.ready()) return "no model image: send it before the settings";
+    if (c.scalar != (sizeof(S) == 4 ? 1 : 0))
+      return sizeof(S) == 4 ? "scalar: this node runs float" : "scalar: this node runs double";
+    if (c.scene.frame.stories != N) return "frame.stories: differs from the model image's";
+    if (c.scene.device.kind != Dev::kKind) return "device.kind: differs from the model image's";
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      if (c.scene.device.vines.law != Dev::kLaw) return "vines.law: differs from the model image's";
+    }
+    const double rate = c.scene.loop.sensor_rate_hz;
+    if (!(std::fabs(model_->h * rate - 1.0) <= 1e-12))
+      return "loop.sensor_rate_hz: differs from the model image's";
+    if (c.scene.loop.contact_scheme != model_->loop.contact_scheme)
+      return "loop.contact_scheme: differs from the model image's";
+    if (c.scene.loop.bounded_substeps != model_->loop.bounded_substeps)
+      return "loop.bounded_substeps: differs from the model image's";
+    return nullptr;
+  }
+
+  static void copy(const char* s, char* out, std::size_t cap) {
+    std::size_t i = 0;
+    for (; s[i] != '\0' && i + 1 < cap; ++i) out[i] = s[i];
+    if (cap > 0) out[i] = '\0';
+  }
+
+  ModelT* model_;
+  DataT* data_;
+  image::Loader<S, N, Dev> loader_;
+  bool configured_ = false;
+  std::int64_t guard_events_ = 0;
+};
+
+}  // namespace vines::link

@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Runs a `vines hil ... --json` command (after `--`) against a board image in
+QEMU and checks its report; exit 0 if every check holds, 1 with the reasons.
+
+  hil_check.py [--max-deviation M] [--all-faults] [--expect-overruns]
+               [--expect-refusal TEXT] -- VINES hil ARGS...
+
+--max-deviation M   every step arrived, outputs finite, and no floor more than
+                    M metres from the host's offline run of the same scalar
+--all-faults        every fault kind injected was detected and survived
+--expect-overruns   the node's deadline monitor counted exactly the steps whose
+                    ticks exceed the budget, and at least one
+--expect-refusal T  the command fails (exit 1) with T in its message
+Always: the report names the board node and its worst step's instructions.
+Standard library only."""
+import json
+import subprocess
+import sys
+
+
+def main(argv):
+    if "--" not in argv:
+        sys.exit(__doc__)
+    cut = argv.index("--")
+    opts, cmd = argv[1:cut], argv[cut + 1:]
+    max_dev = refusal = None
+    all_faults = overruns = False
+    i = 0
+    while i < len(opts):
+        if opts[i] == "--max-deviation":
+            max_dev = float(opts[i + 1]); i += 2
+        elif opts[i] == "--expect-refusal":
+            refusal = opts[i + 1]; i += 2
+        elif opts[i] == "--all-faults":
+            all_faults = True; i += 1
+        elif opts[i] == "--expect-overruns":
+            overruns = True; i += 1
+        else:
+            sys.exit(f"hil_check.py: unknown option {opts[i]}")
+    print("running:", " ".join(cmd), flush=True)
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    sys.stderr.write(p.stderr)
+    if refusal is not None:
+        if p.returncode == 1 and refusal in p.stderr:
+            print(f"refused as expected: {p.stderr.strip()}")
+            return 0
+        print(f"FAIL: expected a refusal mentioning '{refusal}', got exit {p.returncode}")
+        return 1
+    if p.returncode != 0:
+        print(f"FAIL: exit status {p.returncode}")
+        return 1
+    j = json.loads(p.stdout)
+    problems = []
+    nd = j["node_deadline"]
+    print(f"node {j['node']}: {j['steps']} of {j['samples']} steps, worst step "
+          f"{j.get('worst_step_instructions')} instructions at k {j.get('worst_step_k')}, median "
+          f"{j.get('median_step_instructions')}; stack {nd['stack_peak_bytes']} B; overruns "
+          f"{nd['overruns']} of budget {nd['budget_ticks']} ticks; deviation from offline "
+          f"{j['max_deviation_from_offline']:.3g} m; faults injected {j['faults_injected']}, detected "
+          f"{j['faults_detected']}, survived {j['faults_survived']}")
+    if not j["node"].startswith("qemu:") or "worst_step_instructions" not in j:
+        problems.append("the report does not name a board node with its worst step")
+    if not j["outputs_finite"]:
+        problems.append("outputs not finite")
+    if max_dev is not None:
+        if j["steps"] != j["samples"]:
+            problems.append(f"{j['samples'] - j['steps']} steps missing")
+        if not j["max_deviation_from_offline"] <= max_dev:
+            problems.append(f"deviation {j['max_deviation_from_offline']:.3g} m > {max_dev:g} m")
+    if all_faults:
+        for kind, c in j["faults"].items():
+            if not (c["injected"] > 0 and c["detected"] == c["injected"] and c["survived"] == c["injected"]):
+                problems.append(f"fault {kind}: {c}")
+        if len(j["faults"]) < 9:
+            problems.append(f"only {sorted(j['faults'])} injected")
+    if overruns:
+        over = j["steps_over_budget"]
+        if not (nd["overruns"] > 0 and nd["overruns"] == over):
+            problems.append(f"node counted {nd['overruns']} overruns, telemetry shows {over} steps over budget")
+    for m in problems:
+        print("FAIL:", m)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
