@@ -298,17 +298,22 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   ASSERT_TRUE(link::decode(blob, n, &d));
   EXPECT_EQ(d.scene.loop.contact_scheme, ContactScheme::kBounded);
   EXPECT_EQ(d.scene.loop.bounded_substeps, 11);
-  // The last two bytes: scheme, budget.
-  EXPECT_EQ(blob[n - 2], 1);
-  EXPECT_EQ(blob[n - 1], 11);
-  for (const auto& [at, value] : {std::pair<std::size_t, std::uint8_t>{n - 2, 2}, {n - 1, 1}, {n - 1, 65}}) {
+  // The scheme and budget bytes, before the deadline budget (u32, last).
+  const std::size_t at_scheme = n - 6, at_budget = n - 5;
+  EXPECT_EQ(blob[at_scheme], 1);
+  EXPECT_EQ(blob[at_budget], 11);
+  for (const auto& [at, value] :
+       {std::pair<std::size_t, std::uint8_t>{at_scheme, 2}, {at_budget, 1}, {at_budget, 65}}) {
     std::uint8_t bad[link::kMaxConfigBlob];
     std::memcpy(bad, blob, n);
     bad[at] = value;
     EXPECT_FALSE(link::decode(bad, n, &d)) << at << " " << int(value);
   }
   // A blob of the previous layout (without the two bytes) is refused.
-  EXPECT_FALSE(link::decode(blob, n - 2, &d));
+  std::uint8_t old[link::kMaxConfigBlob];
+  std::memcpy(old, blob, at_scheme);
+  std::memcpy(old + at_scheme, blob + at_scheme + 2, 4);
+  EXPECT_FALSE(link::decode(old, n - 2, &d));
 }
 
 }  // namespace

@@ -3,13 +3,15 @@
 QEMU and checks its report; exit 0 if every check holds, 1 with the reasons.
 
   hil_check.py [--max-deviation M] [--all-faults] [--expect-overruns]
-               [--expect-refusal TEXT] -- VINES hil ARGS...
+               [--no-overruns] [--expect-refusal TEXT] -- VINES hil ARGS...
 
 --max-deviation M   every step arrived, outputs finite, and no floor more than
                     M metres from the host's offline run of the same scalar
 --all-faults        every fault kind injected was detected and survived
 --expect-overruns   the node's deadline monitor counted exactly the steps whose
                     ticks exceed the budget, and at least one
+--no-overruns       no step's ticks exceed the budget (the node's count and the
+                    telemetry's both zero)
 --expect-refusal T  the command fails (exit 1) with T in its message
 Always: the report names the board node and its worst step's instructions.
 Standard library only."""
@@ -24,7 +26,7 @@ def main(argv):
     cut = argv.index("--")
     opts, cmd = argv[1:cut], argv[cut + 1:]
     max_dev = refusal = None
-    all_faults = overruns = False
+    all_faults = overruns = no_overruns = False
     i = 0
     while i < len(opts):
         if opts[i] == "--max-deviation":
@@ -35,6 +37,8 @@ def main(argv):
             all_faults = True; i += 1
         elif opts[i] == "--expect-overruns":
             overruns = True; i += 1
+        elif opts[i] == "--no-overruns":
+            no_overruns = True; i += 1
         else:
             sys.exit(f"hil_check.py: unknown option {opts[i]}")
     print("running:", " ".join(cmd), flush=True)
@@ -77,6 +81,10 @@ def main(argv):
         over = j["steps_over_budget"]
         if not (nd["overruns"] > 0 and nd["overruns"] == over):
             problems.append(f"node counted {nd['overruns']} overruns, telemetry shows {over} steps over budget")
+    if no_overruns:
+        if nd["overruns"] != 0 or j["steps_over_budget"] != 0:
+            problems.append(f"{nd['overruns']} steps overran the budget of {nd['budget_ticks']} ticks "
+                            f"(telemetry: {j['steps_over_budget']}), worst {nd['worst_ticks']} at k {nd['worst_k']}")
     for m in problems:
         print("FAIL:", m)
     return 1 if problems else 0
