@@ -166,7 +166,7 @@ void check_overlap(const StressCase& c, const ModelInfo& info, const Pass& full,
 
 // Halved step on the same piecewise-linear input, compared at the sample
 // shortly after the first contact (the end if none): later, after many
-// impacts, the VI NES is chaotic (MODEL.md) and nothing is comparable.
+// impacts, the VI NES is chaotic (docs/model.md section 12) and nothing is comparable.
 void check_half_step(const StressCase& c, const SceneParams& p, const ModelInfo& info, const std::vector<double>& a,
                      const Pass& full, StressResult* r) {
   SceneParams half = p;

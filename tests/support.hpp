@@ -1,4 +1,4 @@
-// Helpers shared by the simulation tests: the El Centro record of MODEL.md and
+// Helpers shared by the simulation tests: the El Centro record of docs/model.md section 6 and
 // a run of a compiled engine over a sample sequence.
 #pragma once
 
@@ -17,7 +17,8 @@ inline std::string ground_motion(const std::string& file) {
   return std::string(VINES_DEFAULT_GROUND_MOTIONS) + "/" + file;
 }
 
-// MODEL.md's El Centro (2688 points, dt 0.02 s, g) at the given sensor rate.
+// El Centro as docs/model.md section 6 pins it (2688 points, dt 0.02 s, g),
+// at the given sensor rate.
 inline std::vector<double> elcentro(double rate_hz) {
   hal::RecordSpec spec;
   spec.path = ground_motion("elcentro_1940_ns_2688pts_dt002_time_g.dat");

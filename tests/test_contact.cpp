@@ -72,7 +72,7 @@ TEST(Bounce, KuwabaraLosesWhatTheRateTermDissipates) {
 }
 
 TEST(Calibration, DefaultParticleTauMatchesModelMd) {
-  // MODEL.md: eps 0.7 at v_ref 0.5 m/s gives tau = 6.247108475e-4 s for the
+  // docs/model.md section 4.3: eps 0.7 at v_ref 0.5 m/s gives tau = 6.247108475e-4 s for the
   // default particle (5 % of the first-mode effective mass, steel on steel).
   FrameParams fp;
   apply_frame_preset(FramePreset::kTable1, &fp);

@@ -38,7 +38,7 @@ TEST(Fixed, EigenArraysTakeIt) {
   EXPECT_EQ(c(2), Q(-1.0));
 }
 
-// The bare frame of MODEL.md at 1 kHz: top-floor displacement from the double
+// The bare frame of docs/model.md section 2 at 1 kHz: top-floor displacement from the double
 // step and from the Q3.28 step (scales: 10x the static response to the PGA).
 struct FixedRun {
   double peak_double = 0, peak_fixed = 0, max_abs_error = 0;

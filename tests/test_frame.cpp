@@ -1,5 +1,5 @@
-// The shear frame, its modal analysis and the TMD design against MODEL.md and
-// the paper's Table 1.
+// The shear frame, its modal analysis and the TMD design against
+// docs/model.md sections 2 and 3 and the paper's Table 1.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,7 +24,7 @@ TEST(Frame, Table1FirstModeMatchesModelMd) {
   EXPECT_NEAR(md.zeta(0), 0.0200, 5e-5);
   EXPECT_NEAR(md.m_eff(0), 1115.9e3, 0.05e3);
   EXPECT_NEAR(md.m_eff(0) / md.m_eff.sum(), 0.806, 5e-4);
-  // Highest mode: 5.8 Hz (MODEL.md, time scales).
+  // Highest mode: 5.8 Hz (docs/model.md sections 2 and 12).
   EXPECT_NEAR(md.frequency_hz()(9), 5.8, 0.05);
 }
 
@@ -43,7 +43,7 @@ TEST(Frame, ModesAreMassOrthonormalAndDiagonaliseKAndC) {
 }
 
 TEST(Frame, Sadek1997MatchesThePapersModeShapeColumn) {
-  // MODEL.md: Table 1's normalised first mode matches k2 = 59.26 MN/m. The
+  // docs/model.md section 11 (E3): Table 1's normalised first mode matches k2 = 59.26 MN/m. The
   // column is the shape scaled by its participation factor.
   const Modal<10> md = modal_analysis(preset_frame(FramePreset::kSadek1997));
   const double table[10] = {0.175, 0.355, 0.534, 0.708, 0.871, 1.019, 1.146, 1.248, 1.321, 1.359};

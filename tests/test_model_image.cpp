@@ -155,7 +155,7 @@ const char* first_difference(const Model<S, N, Dev>& ma, const Data<S, N, Dev>& 
   return nullptr;
 }
 
-// The first seconds of MODEL.md's El Centro at 1 kHz.
+// The first seconds of El Centro (docs/model.md section 6) at 1 kHz.
 const std::vector<double>& elcentro_head() {
   static const std::vector<double> a = [] {
     std::vector<double> all = test::elcentro(1000.0);

@@ -1,4 +1,5 @@
-// Reproduction of the paper's El Centro results with MODEL.md's settings.
+// Reproduction of the paper's El Centro results with the settings of
+// docs/model.md (section 10, choices; section 12, figures).
 #include <gtest/gtest.h>
 
 #include "support.hpp"

@@ -249,7 +249,7 @@ TEST(ReferenceSlow, ConvergesOnTheVinesPeak) {
               rel(coarse.peak_top, fine.peak_top), rel(coarse.elastic_energy, fine.elastic_energy), early, all);
   EXPECT_LT(early, 1e-9);
   EXPECT_LT(all, 1e-6);
-  // MODEL.md's figures for the default scene.
+  // docs/model.md section 12's figures for the default scene.
   EXPECT_NEAR(fine.peak_top, 0.2310518, 1e-7);
   EXPECT_NEAR(fine.t_peak_top, 5.567, 1e-3);
   EXPECT_EQ(fine.contacts, 18);
@@ -261,7 +261,7 @@ struct LoopCase {
   const char* name;
   DeviceKind kind;
   ContactLaw law;
-  double energy_tol;    // VI NES E_e is chaotic (MODEL.md): loose
+  double energy_tol;    // VI NES E_e is chaotic (docs/model.md section 12): loose
   double count_rtol;    // > 0: compare the contact count at this loop.contact_rtol
 };
 

@@ -1,4 +1,4 @@
-// Scene files: the shipped scenes parse to the MODEL.md parameters, every kind
+// Scene files: the shipped scenes parse to the docs/model.md defaults, every kind
 // of bad scene is refused with a message that names the key, and record files
 // are found where resolve_record_path says.
 #include <gtest/gtest.h>

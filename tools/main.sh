@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds the host program, runs the
-# default El Centro scenes of MODEL.md (VI NES and TMD, each with the bare
+# default El Centro scenes of docs/model.md (VI NES and TMD, each with the bare
 # frame alongside) and plots them like the paper's Fig. 6-9.
 # Results: out/elcentro_vines/, out/elcentro_tmd/ (summary.json,
 # timeseries.csv) and out/plots/*.png.

@@ -19,7 +19,8 @@ struct OdeSpec {
   double tmd_x0 = 0, tmd_v0 = 0;  // TMD relative to its floor at t = 0
   // Particle: starts at y0 from the box centre with velocity v0. Walls in the
   // coordinate r = w - x_floor, w the particle's displacement from its start
-  // (MODEL.md: no cancellation against the starting wall).
+  // (docs/model.md section 3.3, particle coordinate: no cancellation against the
+  // starting wall).
   double y0 = 0, v0 = 0;
   double wall_left = 0, wall_right = 0;
   double count_depth = 0;  // contacts shallower than this are not counted [m]

@@ -2,7 +2,7 @@
 // spirit of LAMMPS pair granular). Each returns the repulsive force for an
 // overlap d > 0 and overlap rate dd, split into its elastic and dissipative
 // parts; the force is applied whenever d > 0, even when the dissipative part
-// makes it tensile near the end of a contact (MODEL.md).
+// makes it tensile near the end of a contact (docs/model.md section 4.5).
 #pragma once
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The two 10-story frames of MODEL.md (Sadek et al. 1997 benchmark).
+// The two 10-story frames of docs/model.md section 2 (Sadek et al. 1997 benchmark).
 #pragma once
 
 #include "vines/params.hpp"

@@ -11,7 +11,7 @@ namespace vines {
 // compile-time N <= kMaxStories chosen by the caller.
 inline constexpr int kMaxStories = 40;
 
-// g used for every g <-> m/s^2 conversion (MODEL.md).
+// g used for every g <-> m/s^2 conversion (docs/model.md section 1, units).
 inline constexpr double kGravity = 9.80665;
 
 enum class DampingRule : std::uint8_t {
