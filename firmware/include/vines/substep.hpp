@@ -386,6 +386,41 @@ VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, cons
   return any;
 }
 
+// The sub-steppers' state vector from the data block: floors (modal), the
+// particle, four zeroed integrals (contact loss, input, damping, E_e), time
+// since the step began, q.
+template <typename S, int N, typename Dev, typename Vec>
+Vec load_state(const Data<S, N, Dev>& d) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  Vec y;
+  y.template head<NX>() = d.z;
+  y(NX) = d.s;
+  y(NX + 1) = d.sd;
+  y.template segment<4>(NX + 2).setZero();
+  y(SubStepper<S, N, Dev>::kT) = S(0);
+  y(SubStepper<S, N, Dev>::kQ) = d.q;
+  return y;
+}
+
+// Writes a sub-stepper's end state y back: mode, state, the step's
+// integrals into the ledger and E_e, the contact force.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+void store_state(Data<S, N, Dev>& d, const Stepper& st, const Vec& y) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  d.mode = st.mode;
+  d.z = y.template head<NX>();
+  d.s = y(NX);
+  d.sd = y(NX + 1);
+  d.q = st.regular() ? y(Stepper::kQ) : S(0);
+  d.ledger.contact += static_cast<double>(y(NX + 2));
+  d.ledger.input += static_cast<double>(y(NX + 3));
+  d.ledger.damping += static_cast<double>(y(NX + 4));
+  d.ee_sum += static_cast<double>(y(NX + 5));
+  S fp, loss;
+  st.force(y, &fp, &loss);
+  d.contact_force = fp;
+}
+
 }  // namespace detail
 
 // Sub-stepped step from the current state to the next sample a1. The
@@ -406,13 +441,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
   const Eigen::Array<S, NX + 2, 1> rtol_scale = rtol * Stepper::error_scale(m);
-  Vec y;
-  y.template head<NX>() = d.z;
-  y(NX) = d.s;
-  y(NX + 1) = d.sd;
-  y.template segment<4>(NX + 2).setZero();
-  y(kT) = S(0);
-  y(kQ) = d.q;
+  Vec y = detail::load_state<S, N, Dev, Vec>(d);
   Vec f = st(S(0), y);
   S u = S(0);  // the integrator's variable; only differences matter
   // Step sizes carried across steps, one per variable.
@@ -551,20 +580,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   if (n > d.count.max_substeps_in_step) d.count.max_substeps_in_step = n;
 
   // Write the state back.
-  d.mode = st.mode;
   d.substep = hc_t;
   d.substep_w = hc_w;
-  d.z = y.template head<NX>();
-  d.s = y(NX);
-  d.sd = y(NX + 1);
-  d.q = st.regular() ? y(kQ) : S(0);
-  d.ledger.contact += static_cast<double>(y(NX + 2));
-  d.ledger.input += static_cast<double>(y(NX + 3));
-  d.ledger.damping += static_cast<double>(y(NX + 4));
-  d.ee_sum += static_cast<double>(y(NX + 5));
-  S fp, loss;
-  st.force(y, &fp, &loss);
-  d.contact_force = fp;
+  detail::store_state(d, st, y);
 }
 
 }  // namespace vines

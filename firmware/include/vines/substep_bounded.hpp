@@ -246,13 +246,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
                      dm.pos_scale;
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
-  Vec y;
-  y.template head<NX>() = d.z;
-  y(NX) = d.s;
-  y(NX + 1) = d.sd;
-  y.template segment<4>(NX + 2).setZero();
-  y(kT) = S(0);
-  y(kQ) = d.q;
+  Vec y = detail::load_state<S, N, Dev, Vec>(d);
   Vec f = st(S(0), y);
   int taken = 0, events = 0;
   bool short_of_budget = false;
@@ -395,18 +389,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   }
 
   // Write the state back (as substep_through).
-  d.mode = st.mode;
-  d.z = y.template head<NX>();
-  d.s = y(NX);
-  d.sd = y(NX + 1);
-  d.q = st.regular() ? y(kQ) : S(0);
-  d.ledger.contact += static_cast<double>(y(NX + 2));
-  d.ledger.input += static_cast<double>(y(NX + 3));
-  d.ledger.damping += static_cast<double>(y(NX + 4));
-  d.ee_sum += static_cast<double>(y(NX + 5));
-  S fp, loss;
-  st.force(y, &fp, &loss);
-  d.contact_force = fp;
+  detail::store_state(d, st, y);
 }
 
 }  // namespace vines
