@@ -83,7 +83,8 @@ constexpr const char* kRunUsage =
     "\n"
     "  SCENE.toml     scene file (see data/scenes/README.md)\n"
     "  --record PATH  use this ground-motion file instead of the scene's [record] path\n"
-    "                 (same format settings as the scene's [record] table)\n"
+    "                 (format read from the file: PEER AT2 or columns; the scene's units,\n"
+    "                 column and scale apply to columns)\n"
     "  --out DIR      output folder (default: out/<scene name>)\n"
     "  --quiet        print nothing but errors\n";
 

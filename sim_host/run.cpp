@@ -128,6 +128,10 @@ Excitation load_excitation(const Scene& scene, const std::string& record_overrid
     if (!fs::is_regular_file(record_override))
       throw std::runtime_error("--record " + record_override + ": no such file");
     spec.path = record_override;
+    // The file says its own format (a PEER AT2 header, else columns), not
+    // the scene's record; the scene's units, column and scale still apply to
+    // columns, and a values-only record keeps the scene's dt.
+    if (spec.format != hal::RecordFormat::kAccel) spec.format = hal::RecordFormat::kAuto;
   } else {
     spec.path = resolve_record_path(spec.path, scene.path);
   }

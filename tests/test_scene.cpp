@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 
 namespace {
@@ -427,6 +428,24 @@ TEST_F(RecordSearch, NotFoundListsPlaces) {
       EXPECT_NE(msg.find(part), std::string::npos) << msg << "\nlacks: " << part;
   }
   EXPECT_THROW(resolve_record_path((dir_ / "nope.dat").string(), scene), SceneError);
+}
+
+// --record PATH: the file's own format, whatever the scene's [record] says
+// (the README's example: the TMD scene, time-accel columns, on a PEER AT2).
+TEST(RecordOverride, FormatComesFromTheFile) {
+  const std::string gm = VINES_DEFAULT_GROUND_MOTIONS;
+  const Scene tmd = load_scene(kScenes + "elcentro_tmd.toml");
+  ASSERT_EQ(tmd.record.format, vines::hal::RecordFormat::kTimeAccel);
+  const vines::host::Excitation kobe =
+      vines::host::load_excitation(tmd, gm + "/kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2");
+  EXPECT_DOUBLE_EQ(kobe.record.dt_s, 0.02);  // the AT2 header: NPTS = 7500, DT = .020
+  EXPECT_EQ(kobe.record.accel_mps2.size(), 7500u);
+  // And the other way: a scene reading an AT2 file, given the columns file.
+  Scene at2 = tmd;
+  at2.record.format = vines::hal::RecordFormat::kAt2;
+  const vines::host::Excitation cols = vines::host::load_excitation(at2, gm + "/" + kElCentro);
+  EXPECT_EQ(cols.record.accel_mps2.size(), 2688u);
+  EXPECT_DOUBLE_EQ(cols.record.dt_s, 0.02);
 }
 
 }  // namespace
