@@ -16,6 +16,7 @@
 #include <fstream>
 #include <thread>
 
+#include "sim_host/cli/cli.hpp"
 #include "sim_host/bench.hpp"
 #include "sim_host/design.hpp"
 #include "sim_host/engine.hpp"
@@ -30,62 +31,6 @@
 #include "vines/model_image.hpp"
 
 namespace {
-
-constexpr const char* kUsage =
-    "vines - Vibro-Impact Nonlinear Energy Sink firmware model (host build)\n"
-    "\n"
-    "usage: vines <command> [options]\n"
-    "\n"
-    "commands:\n"
-    "  run SCENE.toml [--record PATH] [--out DIR]\n"
-    "      Run a scene (frame, device, contact law, record). With a device, the\n"
-    "      bare frame runs on the same record too and x_r, E_r are reported.\n"
-    "      Writes DIR/summary.json and DIR/timeseries.csv (default DIR: out/<scene name>).\n"
-    "  sweep SPEC.toml [--out DIR] [--threads N] [--no-progress]\n"
-    "      Run the grid of scenes a study spec describes (data/studies/*.toml) on all\n"
-    "      cores (or MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv\n"
-    "      and DIR/summary.json (default DIR: out/<spec name>).\n"
-    "  design SCENE.toml --optimize beta|eps|mass_ratio|TABLE.KEY [options]\n"
-    "      Best value of one design parameter for the scene's record or a set of\n"
-    "      records (mean or worst case): coarse grid, then golden-section refinement.\n"
-    "  bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
-    "        [--schemes adaptive,bounded] [--substeps LIST] [--json]\n"
-    "      Speed against accuracy: wall time of full runs and their error against the\n"
-    "      converged reference (data/reference), per sensor rate, tolerance (or bounded\n"
-    "      sub-step budget), contact scheme and scalar.\n"
-    "  reference SCENE.toml [--rtol R] [--out FILE]\n"
-    "      Integrate the scene and its bare frame with the converged reference\n"
-    "      (DOP853 in long double, events located to rounding) at rtol R and 100 R;\n"
-    "      writes FILE (default: data/reference/<scene name>.json).\n"
-    "  stress [--count N] [--seed S] [--threads N] [--case K] [--json] [--out DIR]\n"
-    "      Draw and run N random scenes (frames of 1-40 stories, every contact law,\n"
-    "      every record, PGA x0.05-20, 50 Hz-20 kHz) and check each: finite, energy\n"
-    "      balance, overlaps, sub-step cap, loop guards, convergence at half the step.\n"
-    "  hil SCENE.toml [--mode replay|twin|hybrid] [--realtime] [--json] [--csv FILE]\n"
-    "          [fault options]\n"
-    "      Hardware-in-the-loop bench: runs the firmware node (`vines node`) over the\n"
-    "      link protocol (docs/link_protocol.md), streams the record at the sensor\n"
-    "      rate, injects faults, checks deadlines and compares with the offline run;\n"
-    "      digital-twin monitor and shake-table (hybrid) modes.\n"
-    "  image SCENE.toml [--scalar double|float] --out FILE\n"
-    "      Build the scene's model and write its model image: what a board loads\n"
-    "      instead of building the model itself (firmware/include/vines/model_image.hpp).\n"
-    "  node [--realtime] [--idle-timeout S]\n"
-    "      The firmware node on stdin/stdout (what `vines hil` runs).\n"
-    "  help [COMMAND]\n"
-    "      This text.\n"
-    "\n"
-    "Records are looked up as given, next to the scene file, then in\n"
-    "$VINES_GROUND_MOTIONS (default: ../shared/data/ground_motions beside the repository).\n";
-
-constexpr const char* kRunUsage =
-    "usage: vines run SCENE.toml [--record PATH] [--out DIR] [--quiet]\n"
-    "\n"
-    "  SCENE.toml     scene file (see data/scenes/README.md)\n"
-    "  --record PATH  use this ground-motion file instead of the scene's [record] path\n"
-    "                 (same format settings as the scene's [record] table)\n"
-    "  --out DIR      output folder (default: out/<scene name>)\n"
-    "  --quiet        print nothing but errors\n";
 
 constexpr const char* kSweepUsage =
     "usage: vines sweep SPEC.toml [--out DIR] [--threads N] [--no-progress]\n"
@@ -210,74 +155,6 @@ constexpr const char* kImageUsage =
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
   return 2;
-}
-
-int cmd_run(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  std::string scene_path;
-  RunOptions opt;
-  bool out_given = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kRunUsage, stdout);
-      return 0;
-    } else if (a == "--record" || a == "--out") {
-      if (i + 1 >= args.size()) return usage_error(kRunUsage, a + " needs a value");
-      (a == "--record" ? opt.record_override : opt.out_dir) = args[++i];
-      out_given |= a == "--out";
-    } else if (a == "--quiet") {
-      opt.quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error(kRunUsage, "unknown option " + a);
-    } else if (scene_path.empty()) {
-      scene_path = a;
-    } else {
-      return usage_error(kRunUsage, "more than one scene given");
-    }
-  }
-  if (scene_path.empty()) return usage_error(kRunUsage, "no scene given");
-  try {
-    const Scene scene = load_scene(scene_path);
-    if (!out_given) opt.out_dir = "out/" + scene.name;
-    const nlohmann::json j = run_scene(scene, opt);
-    if (!opt.quiet) {
-      std::printf("scene %s: %s, %d stories, %s, %.0f Hz\n", scene.name.c_str(),
-                  j["device"].get<std::string>().c_str(), j["stories"].get<int>(),
-                  j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>());
-      std::printf("  peak top displacement %.6f m at t = %.3f s\n",
-                  j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>());
-      if (j.contains("x_r"))
-        std::printf("  x_r = %.2f %%   E_r = %.2f %%   (bare peak %.6f m)\n", 100 * j["x_r"].get<double>(),
-                    100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
-      if (j["device"] == "vines")
-        std::printf("  contacts %lld, deepest overlap %.3f mm, contact sub-steps %lld\n",
-                    j["contacts"].get<long long>(), 1e3 * j["max_overlap_m"].get<double>(),
-                    j["counters"]["contact_substeps"].get<long long>());
-      if (!j["energy_balance_residual"].is_null())
-        std::printf("  energy balance residual %.2e (relative)\n", j["energy_balance_residual"].get<double>());
-      std::printf("  loop wall time %.2f ms; results in %s/\n", 1e3 * j["wall_time_s"].get<double>(),
-                  opt.out_dir.c_str());
-    }
-    // Limits the loop ran into are reported, never silent (even with --quiet).
-    const auto& k = j["counters"];
-    const vines::LoopParams& loop = scene.params.loop;
-    if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kAdaptive)
-      std::fprintf(stderr, "vines run: warning: %lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): "
-                   "contacts in them are not resolved\n",
-                   k["substep_cap_hits"].get<long long>(), loop.max_substeps_per_step);
-    if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kBounded)
-      std::fprintf(stderr, "vines run: warning: in %lld steps the sub-step budget (loop.bounded_substeps = %d) "
-                   "could not follow every event: they were deferred to the next step or stepped over\n",
-                   k["substep_cap_hits"].get<long long>(), loop.bounded_substeps);
-    if (k["divergences_rolled_back"].get<long long>() + k["bad_samples_held"].get<long long>() > 0)
-      std::fprintf(stderr, "vines run: warning: %lld diverging steps rolled back, %lld non-finite samples held\n",
-                   k["divergences_rolled_back"].get<long long>(), k["bad_samples_held"].get<long long>());
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines run: %s\n", e.what());
-    return 1;
-  }
 }
 
 int cmd_image(const std::vector<std::string>& args) {
@@ -921,30 +798,45 @@ int cmd_stress(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty()) return usage_error(kUsage, "no command given");
-  const std::string cmd = args.front();
-  args.erase(args.begin());
-  if (cmd == "run") return cmd_run(args);
-  if (cmd == "sweep") return cmd_sweep(args);
-  if (cmd == "design") return cmd_design(args);
-  if (cmd == "bench") return cmd_bench(args);
-  if (cmd == "reference") return cmd_reference(args);
-  if (cmd == "stress") return cmd_stress(args);
-  if (cmd == "hil") return cmd_hil(args);
-  if (cmd == "image") return cmd_image(args);
-  if (cmd == "node") return vines::host::node_main(args);
-  if (cmd == "help" || cmd == "-h" || cmd == "--help") {
-    if (!args.empty() && args[0] == "run") std::fputs(kRunUsage, stdout);
-    else if (!args.empty() && args[0] == "sweep") std::fputs(kSweepUsage, stdout);
-    else if (!args.empty() && args[0] == "design") std::fputs(kDesignUsage, stdout);
-    else if (!args.empty() && args[0] == "bench") std::fputs(kBenchUsage, stdout);
-    else if (!args.empty() && args[0] == "reference") std::fputs(kReferenceUsage, stdout);
-    else if (!args.empty() && args[0] == "stress") std::fputs(kStressUsage, stdout);
-    else if (!args.empty() && args[0] == "hil") std::fputs(kHilUsage, stdout);
-    else if (!args.empty() && args[0] == "image") std::fputs(kImageUsage, stdout);
-    else std::fputs(kUsage, stdout);
-    return 0;
+  // Commands not yet on CLI11 (sim_host/cli/).
+  if (argc > 1) {
+    const std::string cmd = argv[1];
+    const std::vector<std::string> args(argv + 2, argv + argc);
+    if (cmd == "sweep") return cmd_sweep(args);
+    if (cmd == "design") return cmd_design(args);
+    if (cmd == "bench") return cmd_bench(args);
+    if (cmd == "reference") return cmd_reference(args);
+    if (cmd == "stress") return cmd_stress(args);
+    if (cmd == "hil") return cmd_hil(args);
+    if (cmd == "image") return cmd_image(args);
+    if (cmd == "node") return vines::host::node_main(args);
+    if (cmd == "help" && !args.empty()) {
+      const char* usage = args[0] == "sweep" ? kSweepUsage : args[0] == "design" ? kDesignUsage
+                        : args[0] == "bench" ? kBenchUsage : args[0] == "reference" ? kReferenceUsage
+                        : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
+                        : args[0] == "image" ? kImageUsage : nullptr;
+      if (usage) return std::fputs(usage, stdout), 0;
+    }
   }
-  return usage_error(kUsage, "unknown command '" + cmd + "'");
+  using namespace vines::cli;
+  CLI::App vines("vines - Vibro-Impact Nonlinear Energy Sink firmware model (host build)", "vines");
+  vines.footer("Records are looked up as given, next to the scene file, then in $VINES_GROUND_MOTIONS (default: "
+               "../shared/data/ground_motions beside the repository).");
+  vines.require_subcommand(1);
+  // An option given twice: the last one counts.
+  vines.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  use_vines_help(vines);
+  add_run(vines);
+  add_help(vines);
+  try {
+    vines.parse(argc, argv);
+    return kOk;
+  } catch (const CLI::RuntimeError& e) {  // a command's own exit status
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    return report_parse_error(vines, e);
+  } catch (const std::exception& e) {  // refused input
+    std::fprintf(stderr, "vines %s: %s\n", vines.get_subcommands().front()->get_name().c_str(), e.what());
+    return kRefused;
+  }
 }
