@@ -143,82 +143,9 @@ constexpr const char* kHilUsage =
     "  --force-noise N (50) --force-lsb N (10) --comp-delay S (default: delay + 2 zeta/w;\n"
     "  0: no compensation) --comp-order P (1-3, default 2)\n";
 
-constexpr const char* kImageUsage =
-    "usage: vines image SCENE.toml [--scalar double|float] --out FILE\n"
-    "\n"
-    "  Builds the scene's model on this host and writes its model image to FILE\n"
-    "  (format: firmware/include/vines/model_image.hpp); prints its size, version,\n"
-    "  scalar, stories, device and CRC. The record is not read.\n"
-    "  --scalar S   double or float (default: the scene's scalar)\n"
-    "  --out FILE   the image file to write\n";
-
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
   return 2;
-}
-
-int cmd_image(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  std::string scene_path, out, scalar_arg;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kImageUsage, stdout);
-      return 0;
-    } else if (a == "--scalar" || a == "--out") {
-      if (i + 1 >= args.size()) return usage_error(kImageUsage, a + " needs a value");
-      (a == "--out" ? out : scalar_arg) = args[++i];
-      if (a == "--scalar" && scalar_arg != "double" && scalar_arg != "float")
-        return usage_error(kImageUsage, "--scalar takes double or float, got " + scalar_arg);
-      if (a == "--out" && out.empty()) return usage_error(kImageUsage, "--out needs a file name");
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error(kImageUsage, "unknown option " + a);
-    } else if (scene_path.empty()) {
-      scene_path = a;
-    } else {
-      return usage_error(kImageUsage, "more than one scene given");
-    }
-  }
-  if (scene_path.empty()) return usage_error(kImageUsage, "no scene given");
-  if (out.empty()) return usage_error(kImageUsage, "no --out FILE given");
-  try {
-    const Scene scene = load_scene(scene_path);
-    const Scalar scalar = scalar_arg.empty() ? scene.scalar : scalar_arg == "float" ? Scalar::kFloat : Scalar::kDouble;
-    const vines::SceneParams& p = scene.params;
-    std::unique_ptr<Engine> eng = make_engine(p, scalar);
-    if (!eng) throw std::runtime_error(scene.path + ": frame.stories: " + missing_engine(p, scalar));
-    const vines::ParamError e = eng->build(p);
-    if (!e.ok()) {
-      std::string key = e.field;
-      if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
-      throw std::runtime_error(scene.path + ": " + key + ": " + e.message);
-    }
-    const std::vector<std::uint8_t> img = eng->model_image();
-    vines::image::HeaderInfo h;
-    if (!vines::image::read_header(img.data(), img.size(), &h)) throw std::runtime_error("no image written");
-    // Checked writes: a short write or a failed close (disk full) is an error,
-    // and no partial image is left behind.
-    std::FILE* f = std::fopen(out.c_str(), "wb");
-    if (!f) throw std::runtime_error(out + ": cannot open for writing: " + std::strerror(errno));
-    const bool wrote = std::fwrite(img.data(), 1, img.size(), f) == img.size();
-    const int write_errno = errno;
-    const bool closed = std::fclose(f) == 0;
-    if (!wrote || !closed) {
-      const std::string why = std::strerror(wrote ? errno : write_errno);
-      std::error_code ec;
-      if (std::filesystem::is_regular_file(out, ec)) std::remove(out.c_str());
-      throw std::runtime_error(out + ": cannot write: " + why);
-    }
-    std::string device = device_name(p.device.kind);
-    if (p.device.kind == vines::DeviceKind::kVines) device += std::string(" (") + law_name(p.device.vines.law) + ")";
-    std::printf("image %s: %zu bytes, version %u, %s, %u stories, %s, CRC 0x%08x; written to %s\n",
-                scene.name.c_str(), img.size(), static_cast<unsigned>(h.version), h.scalar ? "float" : "double",
-                static_cast<unsigned>(h.stories), device.c_str(), static_cast<unsigned>(h.crc), out.c_str());
-    return 0;
-  } catch (const std::exception& ex) {
-    std::fprintf(stderr, "vines image: %s\n", ex.what());
-    return 1;
-  }
 }
 
 int cmd_design(const std::vector<std::string>& args) {
@@ -808,13 +735,12 @@ int main(int argc, char** argv) {
     if (cmd == "reference") return cmd_reference(args);
     if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
-    if (cmd == "image") return cmd_image(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
       const char* usage = args[0] == "sweep" ? kSweepUsage : args[0] == "design" ? kDesignUsage
                         : args[0] == "bench" ? kBenchUsage : args[0] == "reference" ? kReferenceUsage
                         : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
-                        : args[0] == "image" ? kImageUsage : nullptr;
+                        : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
     }
   }
@@ -827,6 +753,7 @@ int main(int argc, char** argv) {
   vines.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   use_vines_help(vines);
   add_run(vines);
+  add_image(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);

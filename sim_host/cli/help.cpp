@@ -74,7 +74,7 @@ std::string option_lines(const CLI::App* app, const std::string& group) {
   for (const CLI::Option* o : app->get_options())
     if (listed(app, o) && o->get_group() == group) {
       opts.push_back(o);
-      if (label(o).size() <= 20) longest = std::max(longest, label(o).size());
+      if (label(o).size() <= 22) longest = std::max(longest, label(o).size());
     }
   const std::size_t column = 2 + longest + 2;
   std::string out;
