@@ -82,14 +82,6 @@ constexpr const char* kBenchUsage =
     "                  (default: only what the table needs, as a study run does)\n"
     "  --json          print JSON: one object for a single line, else {\"lines\": [...]}\n"
     "  --csv FILE      also write the lines as CSV\n";
-constexpr const char* kReferenceUsage =
-    "usage: vines reference SCENE.toml [--rtol R] [--out FILE] [--quiet]\n"
-    "\n"
-    "  SCENE.toml  scene file (see data/scenes/README.md); its record at its sensor rate\n"
-    "  --rtol R    relative tolerance of the reference (default 1e-15, from 1e-17 to\n"
-    "              1e-4); the convergence check repeats every run at 100 R\n"
-    "  --out FILE  JSON output (default: data/reference/<scene name>.json)\n"
-    "  --quiet     print nothing but errors\n";
 constexpr const char* kStressUsage =
     "usage: vines stress [--count N] [--seed S] [--threads N] [--case K] [--worst W]\n"
     "                    [--json] [--out DIR] [--no-progress]\n"
@@ -470,68 +462,6 @@ int cmd_hil(const std::vector<std::string>& args) {
   }
 }
 
-int cmd_reference(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  std::string scene_path, out;
-  double rtol = 0.0;
-  bool quiet = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kReferenceUsage, stdout);
-      return 0;
-    } else if (a == "--rtol" || a == "--out") {
-      if (i + 1 >= args.size()) return usage_error(kReferenceUsage, a + " needs a value");
-      const std::string& v = args[++i];
-      if (a == "--out") {
-        out = v;
-      } else {
-        char* end = nullptr;
-        rtol = std::strtod(v.c_str(), &end);
-        if (*end != '\0' || !(rtol >= 1e-17 && rtol <= 1e-4))
-          return usage_error(kReferenceUsage, "--rtol takes a number from 1e-17 to 1e-4, got " + v);
-      }
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error(kReferenceUsage, "unknown option " + a);
-    } else if (scene_path.empty()) {
-      scene_path = a;
-    } else {
-      return usage_error(kReferenceUsage, "more than one scene given");
-    }
-  }
-  if (scene_path.empty()) return usage_error(kReferenceUsage, "no scene given");
-  try {
-    const Scene scene = load_scene(scene_path);
-    if (out.empty()) out = "data/reference/" + scene.name + ".json";
-    const nlohmann::json j = reference::reference_report(scene, rtol);
-    const std::filesystem::path file(out);
-    std::error_code ec;
-    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-    std::ofstream f(file);
-    if (ec || !(f << j.dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
-    if (!quiet) {
-      const nlohmann::json& c = j["convergence"];
-      std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), j["rtol"].get<double>(),
-                  j["steps"].get<long long>(), j["wall_s"].get<double>());
-      std::printf("  peak top displacement %.12f m at t = %.6f s; E_e %.10e J s; contacts %d\n",
-                  j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>(),
-                  j["elastic_energy_Js"].get<double>(), j["contacts"].get<int>());
-      std::printf("  x_r = %.4f %%   E_r = %.4f %%   (bare peak %.12f m)\n", 100 * j["x_r"].get<double>(),
-                  100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
-      std::printf("  convergence vs rtol %.0e: peak %.1e, E_e %.1e (relative), contacts %s; written to %s\n",
-                  c["rtol_coarse"].get<double>(), c["peak_rel_diff"].get<double>(),
-                  c["elastic_energy_rel_diff"].get<double>(), c["contacts_equal"].get<bool>() ? "equal" : "DIFFER",
-                  out.c_str());
-    }
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines reference: %s\n", e.what());
-    return 1;
-  }
-}
-
 std::atomic<bool> g_stop{false};
 
 int cmd_sweep(const std::vector<std::string>& args) {
@@ -732,14 +662,12 @@ int main(int argc, char** argv) {
     if (cmd == "sweep") return cmd_sweep(args);
     if (cmd == "design") return cmd_design(args);
     if (cmd == "bench") return cmd_bench(args);
-    if (cmd == "reference") return cmd_reference(args);
     if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
       const char* usage = args[0] == "sweep" ? kSweepUsage : args[0] == "design" ? kDesignUsage
-                        : args[0] == "bench" ? kBenchUsage : args[0] == "reference" ? kReferenceUsage
-                        : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
+                        : args[0] == "bench" ? kBenchUsage : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
                         : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
     }
@@ -754,6 +682,7 @@ int main(int argc, char** argv) {
   use_vines_help(vines);
   add_run(vines);
   add_image(vines);
+  add_reference(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);
