@@ -32,16 +32,6 @@
 
 namespace {
 
-constexpr const char* kSweepUsage =
-    "usage: vines sweep SPEC.toml [--out DIR] [--threads N] [--no-progress]\n"
-    "\n"
-    "  SPEC.toml      study spec (format at the top of sim_host/sweep.hpp and in\n"
-    "                 data/studies/README.md)\n"
-    "  --out DIR      output folder (default: out/<spec name>)\n"
-    "  --threads N    worker threads (default: all cores; per rank under MPI)\n"
-    "  --no-progress  no progress bar / lines on stderr\n"
-    "Ctrl-C stops after the runs under way and keeps what finished.\n";
-
 constexpr const char* kDesignUsage =
     "usage: vines design SCENE.toml --optimize NAME [--range LO HI] [--records P1,P2,...]\n"
     "                    [--objective mean|worst] [--metric x_r|E_r] [--coarse N] [--refine N]\n"
@@ -464,79 +454,6 @@ int cmd_hil(const std::vector<std::string>& args) {
 
 std::atomic<bool> g_stop{false};
 
-int cmd_sweep(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  std::string spec_path;
-  SweepOptions opt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kSweepUsage, stdout);
-      return 0;
-    } else if (a == "--out" || a == "--threads") {
-      if (i + 1 >= args.size()) return usage_error(kSweepUsage, a + " needs a value");
-      const std::string& v = args[++i];
-      if (a == "--out") {
-        opt.out_dir = v;
-      } else {
-        char* end = nullptr;
-        const long n = std::strtol(v.c_str(), &end, 10);
-        if (*end != '\0' || n < 1 || n > 1024) return usage_error(kSweepUsage, "--threads takes 1 to 1024");
-        opt.threads = static_cast<int>(n);
-      }
-    } else if (a == "--no-progress") {
-      opt.progress = false;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error(kSweepUsage, "unknown option " + a);
-    } else if (spec_path.empty()) {
-      spec_path = a;
-    } else {
-      return usage_error(kSweepUsage, "more than one spec given");
-    }
-  }
-  if (spec_path.empty()) return usage_error(kSweepUsage, "no spec given");
-  Mpi mpi;
-  try {
-    const SweepSpec spec = load_sweep(spec_path);
-    const std::vector<RunPlan> plan = plan_runs(spec);
-    if (opt.out_dir.empty()) opt.out_dir = "out/" + std::filesystem::path(spec_path).stem().string();
-    std::signal(SIGINT, [](int) {
-      g_stop = true;
-      std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends at once
-    });
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<RunResult> results = execute(spec, plan, opt.threads, mpi.rank(), mpi.size(), &g_stop,
-                                             opt.progress && mpi.rank() == 0);
-    mpi.gather(&results);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (mpi.rank() != 0) return 0;
-    const nlohmann::json s = write_sweep(spec, plan, results, opt.out_dir, wall);
-    std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
-                spec_path.c_str(), s["done"].get<std::size_t>(), plan.size(), wall, s["runs_per_s"].get<double>(),
-                mpi.size(), mpi.size() > 1 ? "s" : "", s["failed"].get<std::size_t>(), opt.out_dir.c_str());
-    for (const auto& st : s["studies"]) {
-      if (st["x_r"].is_null()) continue;
-      std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f",
-                  st["name"].get<std::string>().c_str(), st["device"].get<std::string>().c_str(),
-                  st["runs"].get<std::size_t>(), 100 * st["x_r"]["mean"].get<double>(),
-                  100 * st["x_r"]["sd"].get<double>(), 100 * st["x_r"]["min"].get<double>(),
-                  100 * st["x_r"]["max"].get<double>(), 100 * st["E_r"]["mean"].get<double>(),
-                  100 * st["E_r"]["sd"].get<double>());
-      if (st.contains("best"))
-        std::printf("  best %s = %g", st["best"]["key"].get<std::string>().c_str(), st["best"]["value"].get<double>());
-      std::printf("\n");
-    }
-    if (g_stop) {
-      std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s["done"].get<std::size_t>());
-      return 130;
-    }
-    return s["failed"].get<std::size_t>() == 0 ? 0 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines sweep: %s\n", e.what());
-    return 1;
-  }
-}
-
 // Tables of a stress summary: checks, worst cases, refusals.
 void print_stress(const nlohmann::json& s, int threads) {
   std::printf("stress: %zu cases (seed %llu), %zu refused at load, %zu failed; %.1f s, %.0f cases/s, %d thread%s\n",
@@ -659,14 +576,13 @@ int main(int argc, char** argv) {
   if (argc > 1) {
     const std::string cmd = argv[1];
     const std::vector<std::string> args(argv + 2, argv + argc);
-    if (cmd == "sweep") return cmd_sweep(args);
     if (cmd == "design") return cmd_design(args);
     if (cmd == "bench") return cmd_bench(args);
     if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
-      const char* usage = args[0] == "sweep" ? kSweepUsage : args[0] == "design" ? kDesignUsage
+      const char* usage = args[0] == "design" ? kDesignUsage
                         : args[0] == "bench" ? kBenchUsage : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
                         : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
@@ -683,6 +599,7 @@ int main(int argc, char** argv) {
   add_run(vines);
   add_image(vines);
   add_reference(vines);
+  add_sweep(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);
