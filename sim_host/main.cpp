@@ -32,22 +32,6 @@
 
 namespace {
 
-constexpr const char* kDesignUsage =
-    "usage: vines design SCENE.toml --optimize NAME [--range LO HI] [--records P1,P2,...]\n"
-    "                    [--objective mean|worst] [--metric x_r|E_r] [--coarse N] [--refine N]\n"
-    "                    [--threads N] [--out DIR]\n"
-    "\n"
-    "  --optimize NAME   beta (vines.beta, 1.05-2.0), eps (vines.eps, 0.1-1.0),\n"
-    "                    mass_ratio (device.mass_ratio, 0.01-0.2), or any scene key\n"
-    "                    TABLE.KEY with --range\n"
-    "  --range LO HI     search range (default per parameter)\n"
-    "  --records LIST    comma-separated record files (format detected; the scene's\n"
-    "                    units); default: the scene's record\n"
-    "  --objective       mean (default) or worst over the records\n"
-    "  --metric          x_r (default) or E_r, maximised\n"
-    "  --coarse N        coarse grid points (default 21); --refine N golden steps (12)\n"
-    "  --out DIR         writes DIR/design.json (default: out/design_<scene name>)\n";
-
 constexpr const char* kBenchUsage =
     "usage: vines bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
     "                   [--schemes LIST] [--substeps LIST]\n"
@@ -128,79 +112,6 @@ constexpr const char* kHilUsage =
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
   return 2;
-}
-
-int cmd_design(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  DesignOptions opt;
-  std::string name, out_dir;
-  auto number = [](const std::string& v, double* x) {
-    char* end = nullptr;
-    *x = std::strtod(v.c_str(), &end);
-    return *end == '\0' && std::isfinite(*x);
-  };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kDesignUsage, stdout);
-      return 0;
-    }
-    if (a[0] != '-') {
-      if (!opt.scene_path.empty()) return usage_error(kDesignUsage, "more than one scene given");
-      opt.scene_path = a;
-      continue;
-    }
-    const std::string* v = value();
-    if (!v) return usage_error(kDesignUsage, a + " needs a value");
-    double x = 0;
-    if (a == "--optimize") {
-      name = *v;
-    } else if (a == "--range") {
-      const std::string* v2 = value();
-      if (!v2 || !number(*v, &opt.lo) || !number(*v2, &opt.hi) || !(opt.lo < opt.hi))
-        return usage_error(kDesignUsage, "--range takes two numbers LO < HI");
-    } else if (a == "--records") {
-      std::size_t start = 0;
-      while (start <= v->size()) {
-        const std::size_t comma = v->find(',', start);
-        const std::string item = v->substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        if (!item.empty()) opt.records.push_back(item);
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-      }
-    } else if (a == "--objective" && (*v == "mean" || *v == "worst")) {
-      opt.objective = *v;
-    } else if (a == "--metric" && (*v == "x_r" || *v == "E_r")) {
-      opt.metric = *v;
-    } else if ((a == "--coarse" || a == "--refine" || a == "--threads") && number(*v, &x) && x >= 1 && x <= 1000) {
-      (a == "--coarse" ? opt.coarse : a == "--refine" ? opt.refine : opt.threads) = static_cast<int>(x);
-    } else if (a == "--out") {
-      out_dir = *v;
-    } else {
-      return usage_error(kDesignUsage, "bad option or value: " + a + " " + *v);
-    }
-  }
-  if (opt.scene_path.empty()) return usage_error(kDesignUsage, "no scene given");
-  if (name.empty()) return usage_error(kDesignUsage, "--optimize is required");
-  if (opt.coarse < 3) return usage_error(kDesignUsage, "--coarse needs at least 3 points");
-  if (!design_parameter(name, &opt))
-    return usage_error(kDesignUsage, "--optimize " + name + ": unknown (a scene key needs --range)");
-  try {
-    const Scene scene = load_scene(opt.scene_path);
-    if (out_dir.empty()) out_dir = "out/design_" + scene.name;
-    const nlohmann::json j = optimize_design(opt);
-    std::filesystem::create_directories(out_dir);
-    std::ofstream(std::filesystem::path(out_dir) / "design.json") << j.dump(2) << '\n';
-    std::printf("design %s: best %s = %.6g, %s %s = %.2f %% (%zu evaluations; %s/design.json)\n",
-                scene.name.c_str(), opt.key.c_str(), j["best"]["value"].get<double>(), opt.objective.c_str(),
-                opt.metric.c_str(), 100 * j["best"]["objective"].get<double>(), j["evaluations"].size(),
-                out_dir.c_str());
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines design: %s\n", e.what());
-    return 1;
-  }
 }
 
 // "a,b,c" -> numbers; false if any item is not a finite number > 0.
@@ -576,14 +487,12 @@ int main(int argc, char** argv) {
   if (argc > 1) {
     const std::string cmd = argv[1];
     const std::vector<std::string> args(argv + 2, argv + argc);
-    if (cmd == "design") return cmd_design(args);
     if (cmd == "bench") return cmd_bench(args);
     if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
-      const char* usage = args[0] == "design" ? kDesignUsage
-                        : args[0] == "bench" ? kBenchUsage : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
+      const char* usage = args[0] == "bench" ? kBenchUsage : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
                         : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
     }
@@ -600,6 +509,7 @@ int main(int argc, char** argv) {
   add_image(vines);
   add_reference(vines);
   add_sweep(vines);
+  add_design(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);
