@@ -32,30 +32,6 @@
 
 namespace {
 
-constexpr const char* kBenchUsage =
-    "usage: vines bench SCENE.toml... [--rates LIST] [--rtols LIST] [--scalars LIST]\n"
-    "                   [--schemes LIST] [--substeps LIST]\n"
-    "                   [--baselines LIST | --no-baselines] [--min-time S] [--reference DIR]\n"
-    "                   [--full-outputs] [--json] [--csv FILE]\n"
-    "\n"
-    "  Times full runs of each scene (record loaded, model built; median of repeats)\n"
-    "  and compares them with the scene's reference (DIR/<scene name>.json, default\n"
-    "  data/reference, written by `vines reference`).\n"
-    "  --rates LIST    sensor rates [Hz], comma-separated (default: the scene's)\n"
-    "  --rtols LIST    contact sub-step tolerances (default: the scene's)\n"
-    "  --scalars LIST  double,float (default: the scene's scalar)\n"
-    "  --schemes LIST  contact schemes: adaptive (a line per --rtols), bounded (a line per\n"
-    "                  --substeps) (default: the scene's loop.contact_scheme)\n"
-    "  --substeps LIST bounded scheme: sub-step budgets per sensor step, integers in\n"
-    "                  [2, 64] (default: the scene's loop.bounded_substeps)\n"
-    "  --baselines LIST  SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the\n"
-    "                  record's own points (default 1e-6,1e-8,1e-10; none with --json)\n"
-    "  --no-baselines  no CVODE lines\n"
-    "  --min-time S    time each line for at least S seconds (default 0.3)\n"
-    "  --full-outputs  also compute the scene's per-floor peaks and energy ledger\n"
-    "                  (default: only what the table needs, as a study run does)\n"
-    "  --json          print JSON: one object for a single line, else {\"lines\": [...]}\n"
-    "  --csv FILE      also write the lines as CSV\n";
 constexpr const char* kStressUsage =
     "usage: vines stress [--count N] [--seed S] [--threads N] [--case K] [--worst W]\n"
     "                    [--json] [--out DIR] [--no-progress]\n"
@@ -112,127 +88,6 @@ constexpr const char* kHilUsage =
 int usage_error(const char* usage, const std::string& what) {
   std::fprintf(stderr, "vines: %s\n\n%s", what.c_str(), usage);
   return 2;
-}
-
-// "a,b,c" -> numbers; false if any item is not a finite number > 0.
-bool number_list(const std::string& v, std::vector<double>* out) {
-  std::size_t start = 0;
-  while (start <= v.size()) {
-    const std::size_t comma = v.find(',', start);
-    const std::string item = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0)) return false;
-    out->push_back(x);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return !out->empty();
-}
-
-int cmd_bench(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  std::vector<std::string> scenes;
-  BenchOptions opt;
-  bool as_json = false, no_baselines = false, baselines_given = false;
-  std::string csv;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kBenchUsage, stdout);
-      return 0;
-    }
-    if (a == "--json" || a == "--full-outputs" || a == "--no-baselines") {
-      (a == "--json" ? as_json : a == "--full-outputs" ? opt.full_outputs : no_baselines) = true;
-      continue;
-    }
-    if (a.empty() || a[0] != '-') {
-      scenes.push_back(a);
-      continue;
-    }
-    if (i + 1 >= args.size()) return usage_error(kBenchUsage, a + " needs a value");
-    const std::string& v = args[++i];
-    std::vector<double> xs;
-    if (a == "--rates" || a == "--rtols" || a == "--min-time" || a == "--baselines") {
-      if (!number_list(v, &xs)) return usage_error(kBenchUsage, a + ": not a list of positive numbers: " + v);
-      if (a == "--rates") opt.rates_hz = xs;
-      else if (a == "--rtols") opt.rtols = xs;
-      else if (a == "--baselines") opt.baseline_rtols = xs, baselines_given = true;
-      else opt.min_time_s = xs[0];
-    } else if (a == "--substeps") {
-      if (!number_list(v, &xs)) return usage_error(kBenchUsage, a + ": not a list of positive numbers: " + v);
-      for (double x : xs) {
-        if (x != std::floor(x) || x < vines::kMinBoundedSubsteps || x > vines::kMaxBoundedSubsteps)
-          return usage_error(kBenchUsage, a + ": budgets must be integers in [2, 64]: " + v);
-        opt.bounded_substeps.push_back(static_cast<int>(x));
-      }
-    } else if (a == "--schemes") {
-      for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
-        c = v.find(',', s);
-        if (c == std::string::npos) c = v.size();
-        const std::string name = v.substr(s, c - s);
-        if (name != "adaptive" && name != "bounded")
-          return usage_error(kBenchUsage, a + ": unknown contact scheme '" + name + "' (adaptive, bounded)");
-        opt.schemes.push_back(name);
-      }
-    } else if (a == "--scalars") {
-      for (std::size_t s = 0, c; s <= v.size(); s = c + 1) {
-        c = v.find(',', s);
-        if (c == std::string::npos) c = v.size();
-        opt.scalars.push_back(v.substr(s, c - s));
-      }
-    } else if (a == "--reference") {
-      opt.reference_dir = v;
-    } else if (a == "--csv") {
-      csv = v;
-    } else {
-      return usage_error(kBenchUsage, "unknown option " + a);
-    }
-  }
-  if (scenes.empty()) return usage_error(kBenchUsage, "no scene given");
-  // The table has CVODE baselines by default; --json alone is the scene's own line.
-  if (!baselines_given && !as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
-  if (no_baselines) opt.baseline_rtols.clear();
-  try {
-    std::vector<BenchLine> lines;
-    for (const std::string& path : scenes) {
-      const Scene scene = load_scene(path);
-      BenchOptions o = opt;
-      if (o.scalars.empty()) o.scalars = {scalar_name(scene.scalar)};
-      const std::vector<BenchLine> ls = bench_scene(scene, o);
-      lines.insert(lines.end(), ls.begin(), ls.end());
-      if (!as_json) std::fputs(format_table(ls).c_str(), stdout);
-    }
-    if (!csv.empty()) {
-      std::ofstream out(csv);
-      if (!out) throw std::runtime_error(csv + ": cannot write");
-      bool header = true;
-      for (const BenchLine& l : lines) {
-        const nlohmann::json j = line_json(l);
-        if (header) {
-          for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.key();
-          out << '\n';
-          header = false;
-        }
-        for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.value().dump();
-        out << '\n';
-      }
-    }
-    if (as_json) {
-      nlohmann::json j;
-      if (lines.size() == 1) {
-        j = line_json(lines[0]);
-      } else {
-        j["lines"] = nlohmann::json::array();
-        for (const BenchLine& l : lines) j["lines"].push_back(line_json(l));
-      }
-      std::printf("%s\n", j.dump(2).c_str());
-    }
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines bench: %s\n", e.what());
-    return 1;
-  }
 }
 
 // One line of the hil report.
@@ -487,12 +342,11 @@ int main(int argc, char** argv) {
   if (argc > 1) {
     const std::string cmd = argv[1];
     const std::vector<std::string> args(argv + 2, argv + argc);
-    if (cmd == "bench") return cmd_bench(args);
     if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
-      const char* usage = args[0] == "bench" ? kBenchUsage : args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
+      const char* usage = args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
                         : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
     }
@@ -510,6 +364,7 @@ int main(int argc, char** argv) {
   add_reference(vines);
   add_sweep(vines);
   add_design(vines);
+  add_bench(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);
