@@ -32,22 +32,6 @@
 
 namespace {
 
-constexpr const char* kStressUsage =
-    "usage: vines stress [--count N] [--seed S] [--threads N] [--case K] [--worst W]\n"
-    "                    [--json] [--out DIR] [--no-progress]\n"
-    "\n"
-    "  --count N      random scenes to draw and run (default 2000)\n"
-    "  --seed S       seed of the draw (default 1); case K of seed S is always the same scene\n"
-    "  --threads N    worker threads (default: all cores); results do not depend on it\n"
-    "  --case K       draw and run only case K, and report it in full\n"
-    "  --worst W      cases listed per check (default 5)\n"
-    "  --json         print one JSON object instead of tables\n"
-    "  --out DIR      write DIR/stress.json, every case to DIR/cases.jsonl, and the listed\n"
-    "                 cases as scenes DIR/case_K.toml (with their record windows) that\n"
-    "                 `vines run` runs as they were\n"
-    "  --no-progress  no progress on stderr\n"
-    "Exit status 1 if any check fails.\n";
-
 constexpr const char* kHilUsage =
     "usage: vines hil SCENE.toml [--mode replay|twin|hybrid] [--realtime | --virtual-clock]\n"
     "                 [--duration S] [--json] [--csv FILE] [--timeout S] [--deadline PERIODS]\n"
@@ -218,123 +202,6 @@ int cmd_hil(const std::vector<std::string>& args) {
   }
 }
 
-std::atomic<bool> g_stop{false};
-
-// Tables of a stress summary: checks, worst cases, refusals.
-void print_stress(const nlohmann::json& s, int threads) {
-  std::printf("stress: %zu cases (seed %llu), %zu refused at load, %zu failed; %.1f s, %.0f cases/s, %d thread%s\n",
-              s["cases"].get<std::size_t>(), s["seed"].get<unsigned long long>(), s["refused"].get<std::size_t>(),
-              s["failed"].get<std::size_t>(), s["wall_time_s"].get<double>(), s["cases_per_s"].get<double>(), threads,
-              threads > 1 ? "s" : "");
-  std::printf("\n%-12s %6s %7s %12s %12s\n", "check", "runs", "failed", "worst", "bound");
-  for (const auto& [name, c] : s["checks"].items()) {
-    const auto& w = c["worst"];
-    std::printf("%-12s %6zu %7zu", name.c_str(), c["runs"].get<std::size_t>(), c["failed"].get<std::size_t>());
-    if (w.empty()) std::printf(" %12s", "0");
-    else std::printf(" %12.3g %12.3g", w[0]["value"].get<double>(), w[0]["bound"].get<double>());
-    std::printf("\n");
-  }
-  std::printf("\nworst cases per check (re-run one with: vines stress --seed %llu --case K --json):\n",
-              s["seed"].get<unsigned long long>());
-  std::printf("%-12s %6s %10s %10s %3s %-11s %-6s %8s %7s %5s %5s %6s %-s\n", "check", "case", "value", "bound", "N",
-              "device", "scalar", "rate_hz", "pga_x", "beta", "eps", "mu_%", "record");
-  for (const auto& [name, c] : s["checks"].items())
-    for (const auto& w : c["worst"]) {
-      const auto& sc = w["scene"];
-      const bool dev = sc["device"] != "none";
-      std::printf("%-12s %6lld %10.3g %10.3g %3d %-11s %-6s %8.1f %7.3f %5s %5s %6s %s%s\n", name.c_str(),
-                  sc["case"].get<long long>(), w["value"].get<double>(), w["bound"].get<double>(),
-                  sc["stories"].get<int>(), sc["device"].get<std::string>().c_str(),
-                  sc["scalar"].get<std::string>().c_str(), sc["sensor_rate_hz"].get<double>(),
-                  sc["pga_scale"].get<double>(), dev ? std::to_string(sc["beta"].get<double>()).substr(0, 5).c_str() : "-",
-                  dev ? std::to_string(sc["eps"].get<double>()).substr(0, 5).c_str() : "-",
-                  dev ? std::to_string(100 * sc["mass_ratio"].get<double>()).substr(0, 6).c_str() : "-",
-                  sc["record"].get<std::string>().c_str(), w["ok"].get<bool>() ? "" : "  FAIL");
-    }
-  if (!s["refusals"].empty()) {
-    std::printf("\nrefused at scene load:\n");
-    for (const auto& r : s["refusals"])
-      std::printf("  %5zu x %s (e.g. case %lld)\n", r["cases"].get<std::size_t>(),
-                  r["reason"].get<std::string>().c_str(), r["first_case"].get<long long>());
-  }
-}
-
-int cmd_stress(const std::vector<std::string>& args) {
-  using namespace vines::host;
-  StressOptions opt;
-  long long one_case = -1;
-  int worst = 5;
-  bool as_json = false;
-  std::string out_dir;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kStressUsage, stdout);
-      return 0;
-    } else if (a == "--json") {
-      as_json = true;
-    } else if (a == "--no-progress") {
-      opt.progress = false;
-    } else if (a == "--count" || a == "--seed" || a == "--threads" || a == "--case" || a == "--worst" ||
-               a == "--out") {
-      if (i + 1 >= args.size()) return usage_error(kStressUsage, a + " needs a value");
-      const std::string& v = args[++i];
-      if (a == "--out") {
-        out_dir = v;
-        continue;
-      }
-      char* end = nullptr;
-      const unsigned long long n = std::strtoull(v.c_str(), &end, 10);
-      if (v.empty() || v[0] == '-' || *end != '\0') return usage_error(kStressUsage, a + " takes a whole number");
-      if (a == "--seed") opt.seed = n;
-      else if (a == "--case") one_case = static_cast<long long>(std::min(n, 1ull << 62));
-      else if (n < 1 || n > (a == "--count" ? 1000000ull : 1024ull))
-        return usage_error(kStressUsage, a + " out of range");
-      else if (a == "--count") opt.count = static_cast<long long>(n);
-      else if (a == "--threads") opt.threads = static_cast<int>(n);
-      else worst = static_cast<int>(n);
-    } else {
-      return usage_error(kStressUsage, "unknown argument " + a);
-    }
-  }
-  try {
-    const std::vector<StressRecord> records = load_stress_records();
-    // One case, in full.
-    if (one_case >= 0) {
-      const StressCase c = draw_case(opt.seed, one_case, records, opt.limits);
-      const StressResult r = run_case(c, records);
-      nlohmann::json j = case_report(c, r, records);
-      if (!out_dir.empty()) j["scene_file"] = write_case_scene(c, records, out_dir);
-      std::printf("%s\n", j.dump(as_json ? -1 : 2).c_str());
-      return r.ok() ? 0 : 1;
-    }
-    std::signal(SIGINT, [](int) {
-      g_stop = true;
-      std::signal(SIGINT, SIG_DFL);
-    });
-    const StressRun run = run_stress(opt, records, &g_stop);
-    nlohmann::json s = stress_summary(opt, run, records, worst);
-    if (!out_dir.empty()) {
-      std::filesystem::create_directories(out_dir);
-      for (auto& [name, c] : s["checks"].items())
-        for (auto& w : c["worst"])
-          w["scene_file"] = write_case_scene(run.cases[w["scene"]["case"].get<std::size_t>()], records, out_dir);
-      std::ofstream(std::filesystem::path(out_dir) / "stress.json") << s.dump(2) << '\n';
-      std::ofstream cases(std::filesystem::path(out_dir) / "cases.jsonl");
-      for (std::size_t i = 0; i < run.results.size(); ++i)
-        if (run.results[i].done) cases << case_report(run.cases[i], run.results[i], records).dump() << '\n';
-    }
-    const int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    if (as_json) std::printf("%s\n", s.dump().c_str());
-    else print_stress(s, threads);
-    if (g_stop) return 130;
-    return s["passed"].get<bool>() ? 0 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "vines stress: %s\n", e.what());
-    return 1;
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -342,11 +209,10 @@ int main(int argc, char** argv) {
   if (argc > 1) {
     const std::string cmd = argv[1];
     const std::vector<std::string> args(argv + 2, argv + argc);
-    if (cmd == "stress") return cmd_stress(args);
     if (cmd == "hil") return cmd_hil(args);
     if (cmd == "node") return vines::host::node_main(args);
     if (cmd == "help" && !args.empty()) {
-      const char* usage = args[0] == "stress" ? kStressUsage : args[0] == "hil" ? kHilUsage
+      const char* usage = args[0] == "hil" ? kHilUsage
                         : nullptr;
       if (usage) return std::fputs(usage, stdout), 0;
     }
@@ -365,6 +231,7 @@ int main(int argc, char** argv) {
   add_sweep(vines);
   add_design(vines);
   add_bench(vines);
+  add_stress(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);

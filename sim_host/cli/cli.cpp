@@ -59,9 +59,10 @@ CLI::Option* add_list(CLI::App& cmd, const std::string& name, bool whole, double
   return cmd.add_option_function<std::string>(name, set, help)->type_name("LIST")->check(CLI::Validator(check, ""));
 }
 
+// A bound as a message shows it: whole numbers in full (1000000, not 1e+06).
 std::string number_text(double x) {
   char s[32];
-  std::snprintf(s, sizeof s, "%g", x);
+  std::snprintf(s, sizeof s, x == std::floor(x) && std::fabs(x) < 1e18 ? "%.0f" : "%g", x);
   return s;
 }
 
@@ -80,7 +81,7 @@ CLI::Option* add_number_list(CLI::App& cmd, const std::string& name, std::vector
 }
 
 CLI::Validator number_in(double lo, double hi) {
-  const std::string range = "from " + number_text(lo) + " to " + number_text(hi);
+  const std::string range = hi < 1e18 ? "from " + number_text(lo) + " to " + number_text(hi) : ">= " + number_text(lo);
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         char* end = nullptr;

@@ -34,7 +34,8 @@ CLI::Option* add_number_list(CLI::App& cmd, const std::string& name, std::vector
                              const std::string& help);
 
 // Checks of a number option, whose message names the value: a number from lo
-// to hi; a number > 0 and at most hi. (CLI::Range lets NaN through.)
+// to hi (hi from 1e18 on: no upper bound but the type's); a number > 0 and at
+// most hi. (CLI::Range lets NaN through.)
 CLI::Validator number_in(double lo, double hi);
 CLI::Validator positive_up_to(double hi);
 

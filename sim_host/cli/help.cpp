@@ -67,6 +67,17 @@ std::string synopsis(const CLI::App* app) {
   return s;
 }
 
+// The synopsis wrapped as wrap() does, never inside an item ("[--out DIR]").
+std::string wrapped_synopsis(const CLI::App* app, std::size_t indent, std::size_t first) {
+  std::string s = synopsis(app);
+  for (std::size_t open = 0; (open = s.find('[', open)) != std::string::npos;)
+    for (const std::size_t close = s.find(']', open); ++open < close;)
+      if (s[open] == ' ') s[open] = '\x01';
+  s = wrap(s, indent, first);
+  std::replace(s.begin(), s.end(), '\x01', ' ');
+  return s;
+}
+
 // One line per option of a group (wrapped descriptions in a column).
 std::string option_lines(const CLI::App* app, const std::string& group) {
   std::vector<const CLI::Option*> opts;
@@ -99,7 +110,7 @@ class Formatter : public CLI::Formatter {
     std::string out = vines->get_description() + "\n\nusage: vines <command> [options]\n\ncommands:\n";
     for (const CLI::App* c : vines->get_subcommands([](const CLI::App*) { return true; })) {
       const std::string head = "  " + c->get_name() + " ";
-      out += head + wrap(synopsis(c), head.size() + 2, head.size()) + "\n";
+      out += head + wrapped_synopsis(c, head.size() + 2, head.size()) + "\n";
       out += "      " + wrap(c->get_description(), 6, 6) + "\n";
     }
     return out + "\n" + wrap(vines->get_footer(), 0, 0) + "\n";
@@ -107,7 +118,7 @@ class Formatter : public CLI::Formatter {
 
   static std::string command_help(const CLI::App* cmd) {
     const std::string head = "usage: vines " + cmd->get_name() + " ";
-    std::string out = head + wrap(synopsis(cmd), head.size(), head.size()) + "\n\n";
+    std::string out = head + wrapped_synopsis(cmd, head.size(), head.size()) + "\n\n";
     out += "  " + wrap(cmd->get_description(), 2, 2) + "\n\n";
     out += option_lines(cmd, "Options");
     std::vector<std::string> groups;
@@ -117,7 +128,7 @@ class Formatter : public CLI::Formatter {
         groups.push_back(o->get_group());
         out += o->get_group() + ":\n" + option_lines(cmd, o->get_group());
       }
-    if (!cmd->get_footer().empty()) out += wrap(cmd->get_footer(), 0, 0) + "\n";
+    if (!cmd->get_footer().empty()) out += "\n" + wrap(cmd->get_footer(), 0, 0) + "\n";
     return out;
   }
 };
