@@ -78,18 +78,20 @@ std::string wrapped_synopsis(const CLI::App* app, std::size_t indent, std::size_
   return s;
 }
 
-// One line per option of a group (wrapped descriptions in a column).
-std::string option_lines(const CLI::App* app, const std::string& group) {
-  std::vector<const CLI::Option*> opts;
+// The column of the options' descriptions: after the longest name (up to a limit).
+std::size_t description_column(const CLI::App* app) {
   std::size_t longest = 0;
   for (const CLI::Option* o : app->get_options())
-    if (listed(app, o) && o->get_group() == group) {
-      opts.push_back(o);
-      if (label(o).size() <= 22) longest = std::max(longest, label(o).size());
-    }
-  const std::size_t column = 2 + longest + 2;
+    if (listed(app, o) && label(o).size() <= 22) longest = std::max(longest, label(o).size());
+  return 2 + longest + 2;
+}
+
+// One line per option of a group, descriptions wrapped in their column.
+std::string option_lines(const CLI::App* app, const std::string& group) {
+  const std::size_t column = description_column(app);
   std::string out;
-  for (const CLI::Option* o : opts) {
+  for (const CLI::Option* o : app->get_options()) {
+    if (!listed(app, o) || o->get_group() != group) continue;
     const std::string name = "  " + label(o);
     out += name;
     if (name.size() + 2 > column) out += "\n" + std::string(column, ' ');
@@ -126,7 +128,7 @@ class Formatter : public CLI::Formatter {
       if (listed(cmd, o) && o->get_group() != "Options" &&
           std::find(groups.begin(), groups.end(), o->get_group()) == groups.end()) {
         groups.push_back(o->get_group());
-        out += o->get_group() + ":\n" + option_lines(cmd, o->get_group());
+        out += "\n" + o->get_group() + ":\n" + option_lines(cmd, o->get_group());
       }
     if (!cmd->get_footer().empty()) out += "\n" + wrap(cmd->get_footer(), 0, 0) + "\n";
     return out;
