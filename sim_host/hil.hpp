@@ -68,7 +68,8 @@ FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
 // input (scene, option, node) on any error the user can cause.
 nlohmann::json run_hil(const Scene& scene, const HilOptions& opt);
 
-// `vines node`: the host firmware node on stdin/stdout.
-int node_main(const std::vector<std::string>& args);
+// `vines node`: the host firmware node on stdin/stdout, deadlines on the local
+// clock with realtime; it gives up after idle_timeout_s without a byte.
+int node_main(bool realtime, double idle_timeout_s);
 
 }  // namespace vines::host
