@@ -35,7 +35,19 @@ std::string wrap(const std::string& text, std::size_t indent, std::size_t first)
   return out;
 }
 
+const std::string kMainGroup = "Options";  // CLI11's default group
+
 bool listed(const CLI::App* app, const CLI::Option* o) { return o != app->get_help_ptr(); }
+
+// The option groups but the main one, in the order of their first option.
+std::vector<std::string> other_groups(const CLI::App* app) {
+  std::vector<std::string> groups;
+  for (const CLI::Option* o : app->get_options())
+    if (listed(app, o) && o->get_group() != kMainGroup &&
+        std::find(groups.begin(), groups.end(), o->get_group()) == groups.end())
+      groups.push_back(o->get_group());
+  return groups;
+}
 
 // An argument as the help names it: "SCENE.toml", "--out DIR", "--realtime | --virtual-clock".
 std::string label(const CLI::Option* o) {
@@ -50,18 +62,14 @@ std::string label(const CLI::Option* o) {
 // The arguments after `vines NAME` in the usage line: positionals, the options
 // of the main group, then "[GROUP]" for each other group.
 std::string synopsis(const CLI::App* app) {
-  std::vector<std::string> items, groups;
+  std::vector<std::string> items;
   for (const CLI::Option* o : app->get_options()) {
-    if (!listed(app, o)) continue;
-    if (o->get_group() != "Options") {
-      if (std::find(groups.begin(), groups.end(), o->get_group()) == groups.end()) groups.push_back(o->get_group());
-      continue;
-    }
+    if (!listed(app, o) || o->get_group() != kMainGroup) continue;
     std::string item = label(o);
     if (o->get_positional() && o->get_items_expected_max() > 1) item += "...";
     items.push_back(o->get_required() ? item : "[" + item + "]");
   }
-  for (const std::string& g : groups) items.push_back("[" + g + "]");
+  for (const std::string& g : other_groups(app)) items.push_back("[" + g + "]");
   std::string s;
   for (const std::string& i : items) s += (s.empty() ? "" : " ") + i;
   return s;
@@ -101,37 +109,32 @@ std::string option_lines(const CLI::App* app, const std::string& group) {
   return out;
 }
 
-class Formatter : public CLI::Formatter {
+// `vines help`: the commands, each with its usage and summary.
+std::string vines_help(const CLI::App* vines) {
+  std::string out = vines->get_description() + "\n\nusage: vines <command> [options]\n\ncommands:\n";
+  for (const CLI::App* c : vines->get_subcommands([](const CLI::App*) { return true; })) {
+    const std::string head = "  " + c->get_name() + " ";
+    out += head + wrapped_synopsis(c, head.size() + 2, head.size()) + "\n";
+    out += "      " + wrap(c->get_description(), 6, 6) + "\n";
+  }
+  return out + "\n" + wrap(vines->get_footer(), 0, 0) + "\n";
+}
+
+// `vines help COMMAND`: usage, summary, options (then each other group's), notes.
+std::string command_help(const CLI::App* cmd) {
+  const std::string head = "usage: vines " + cmd->get_name() + " ";
+  std::string out = head + wrapped_synopsis(cmd, head.size(), head.size()) + "\n\n";
+  out += "  " + wrap(cmd->get_description(), 2, 2) + "\n\n";
+  out += option_lines(cmd, kMainGroup);
+  for (const std::string& g : other_groups(cmd)) out += "\n" + g + ":\n" + option_lines(cmd, g);
+  if (!cmd->get_footer().empty()) out += "\n" + wrap(cmd->get_footer(), 0, 0) + "\n";
+  return out;
+}
+
+class Formatter : public CLI::FormatterBase {
  public:
   std::string make_help(const CLI::App* app, std::string, CLI::AppFormatMode) const override {
     return app->get_parent() ? command_help(app) : vines_help(app);
-  }
-
- private:
-  static std::string vines_help(const CLI::App* vines) {
-    std::string out = vines->get_description() + "\n\nusage: vines <command> [options]\n\ncommands:\n";
-    for (const CLI::App* c : vines->get_subcommands([](const CLI::App*) { return true; })) {
-      const std::string head = "  " + c->get_name() + " ";
-      out += head + wrapped_synopsis(c, head.size() + 2, head.size()) + "\n";
-      out += "      " + wrap(c->get_description(), 6, 6) + "\n";
-    }
-    return out + "\n" + wrap(vines->get_footer(), 0, 0) + "\n";
-  }
-
-  static std::string command_help(const CLI::App* cmd) {
-    const std::string head = "usage: vines " + cmd->get_name() + " ";
-    std::string out = head + wrapped_synopsis(cmd, head.size(), head.size()) + "\n\n";
-    out += "  " + wrap(cmd->get_description(), 2, 2) + "\n\n";
-    out += option_lines(cmd, "Options");
-    std::vector<std::string> groups;
-    for (const CLI::Option* o : cmd->get_options())
-      if (listed(cmd, o) && o->get_group() != "Options" &&
-          std::find(groups.begin(), groups.end(), o->get_group()) == groups.end()) {
-        groups.push_back(o->get_group());
-        out += "\n" + o->get_group() + ":\n" + option_lines(cmd, o->get_group());
-      }
-    if (!cmd->get_footer().empty()) out += "\n" + wrap(cmd->get_footer(), 0, 0) + "\n";
-    return out;
   }
 };
 
