@@ -61,6 +61,9 @@ struct HilOptions {
   std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
 };
 
+// The nodes HilOptions::node names: "host", then "qemu:TARGET" for each board.
+std::vector<std::string> node_names();
+
 // Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.
 FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
 

@@ -1,9 +1,11 @@
 // `vines hil SCENE.toml`: the hardware-in-the-loop bench around `vines node`.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/hil.hpp"
@@ -124,8 +126,16 @@ void add_hil(CLI::App& vines) {
   cmd->add_option_function<std::string>(
          "--node",
          [&opt](const std::string& v) {
-           if (v == "host" || v.rfind("qemu:", 0) == 0) opt.node = v;
-           else opt.node_command = v;
+           const std::vector<std::string> names = host::node_names();
+           if (std::find(names.begin(), names.end(), v) != names.end()) {
+             opt.node = v;
+           } else if (v.rfind("qemu:", 0) == 0) {
+             std::string known;
+             for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+             throw CLI::ValidationError("--node", v + ": not a node (" + known + ", or a program's path)");
+           } else {
+             opt.node_command = v;
+           }
          },
          "host (default: `vines node`), qemu:cortex-m4f or qemu:cortex-m7 (the board image in QEMU, float / "
          "double, instructions counted; build the preset first), or the path of a node program")
