@@ -305,6 +305,12 @@ json stats(std::vector<double> v) {
 
 }  // namespace
 
+std::vector<std::string> node_names() {
+  std::vector<std::string> names = {"host"};
+  for (const Board& b : kBoards) names.push_back(std::string("qemu:") + b.target);
+  return names;
+}
+
 json run_hil(const Scene& scene, const HilOptions& opt) {
   if (opt.mode != "replay" && opt.mode != "twin" && opt.mode != "hybrid")
     throw std::runtime_error("--mode " + opt.mode + ": must be replay, twin or hybrid");

@@ -61,6 +61,9 @@ struct HilOptions {
   std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
 };
 
+// The nodes HilOptions::node names: "host", then "qemu:TARGET" for each board.
+std::vector<std::string> node_names();
+
 // Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.
 FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
 
@@ -68,7 +71,8 @@ FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
 // input (scene, option, node) on any error the user can cause.
 nlohmann::json run_hil(const Scene& scene, const HilOptions& opt);
 
-// `vines node`: the host firmware node on stdin/stdout.
-int node_main(const std::vector<std::string>& args);
+// `vines node`: the host firmware node on stdin/stdout, deadlines on the local
+// clock with realtime; it gives up after idle_timeout_s without a byte.
+int node_main(bool realtime, double idle_timeout_s);
 
 }  // namespace vines::host

@@ -9,6 +9,7 @@ packages=(
   cmake make g++                                 # host build
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
+  libcli11-dev                                   # the vines command line
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
   qemu-system-arm                                # runs the MCU images (ctest)

@@ -1,0 +1,115 @@
+// `vines bench SCENE.toml...`: speed against accuracy, against data/reference.
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sim_host/bench.hpp"
+#include "sim_host/cli/cli.hpp"
+#include "sim_host/scene.hpp"
+#include "vines/params.hpp"
+
+namespace vines::cli {
+namespace {
+
+struct BenchArgs {
+  std::vector<std::string> scenes;
+  host::BenchOptions opt;
+  bool as_json = false, no_baselines = false;
+  std::string csv;
+  const CLI::Option* baselines = nullptr;  // --baselines, given or not
+};
+
+// The lines as CSV: a header of the JSON keys, then one row per line.
+void write_csv(const std::string& path, const std::vector<host::BenchLine>& lines) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write");
+  bool header = true;
+  for (const host::BenchLine& l : lines) {
+    const nlohmann::json j = host::line_json(l);
+    if (header) {
+      for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.key();
+      out << '\n';
+      header = false;
+    }
+    for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.value().dump();
+    out << '\n';
+  }
+}
+
+int bench(BenchArgs a) {
+  using namespace vines::host;
+  BenchOptions& opt = a.opt;
+  // The table has CVODE baselines by default; --json alone is the scene's own line.
+  if (a.baselines->count() == 0 && !a.as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
+  if (a.no_baselines) opt.baseline_rtols.clear();
+  std::vector<BenchLine> lines;
+  for (const std::string& path : a.scenes) {
+    const Scene scene = load_scene(path);
+    BenchOptions o = opt;
+    if (o.scalars.empty()) o.scalars = {scalar_name(scene.scalar)};
+    const std::vector<BenchLine> ls = bench_scene(scene, o);
+    lines.insert(lines.end(), ls.begin(), ls.end());
+    if (!a.as_json) std::fputs(format_table(ls).c_str(), stdout);
+  }
+  if (!a.csv.empty()) write_csv(a.csv, lines);
+  if (a.as_json) {
+    nlohmann::json j;
+    if (lines.size() == 1) {
+      j = line_json(lines[0]);
+    } else {
+      j["lines"] = nlohmann::json::array();
+      for (const BenchLine& l : lines) j["lines"].push_back(line_json(l));
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void add_bench(CLI::App& vines) {
+  auto a = std::make_shared<BenchArgs>();
+  host::BenchOptions& opt = a->opt;
+  CLI::App* cmd = add_command(
+      vines, "bench",
+      "Speed against accuracy: wall time of full runs (record loaded, model built; median of repeats) and their "
+      "error against the converged reference (DIR/<scene name>.json, default data/reference, written by `vines "
+      "reference`), per sensor rate, tolerance (or bounded sub-step budget), contact scheme and scalar.",
+      "", [a] { return bench(*a); });
+  cmd->add_option("SCENE.toml", a->scenes, "scene files (see data/scenes/README.md)")->required();
+  add_number_list(*cmd, "--rates", &opt.rates_hz, "sensor rates [Hz] (default: the scene's)");
+  add_number_list(*cmd, "--rtols", &opt.rtols, "contact sub-step tolerances (default: the scene's)");
+  cmd->add_option("--scalars", opt.scalars, "double,float (default: the scene's scalar)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"double", "float"}));
+  cmd->add_option("--schemes", opt.schemes,
+                  "contact schemes: adaptive (a line per --rtols), bounded (a line per --substeps) (default: the "
+                  "scene's loop.contact_scheme)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"adaptive", "bounded"}));
+  add_number_list(*cmd, "--substeps", &opt.bounded_substeps, kMinBoundedSubsteps, kMaxBoundedSubsteps,
+                  "bounded scheme: sub-step budgets per sensor step, integers in [2, 64] (default: the scene's "
+                  "loop.bounded_substeps)");
+  a->baselines = add_number_list(*cmd, "--baselines", &opt.baseline_rtols,
+                                 "SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the record's own points "
+                                 "(default 1e-6,1e-8,1e-10; none with --json)");
+  cmd->add_flag("--no-baselines", a->no_baselines, "no CVODE lines");
+  cmd->add_option("--min-time", opt.min_time_s, "time each line for at least S seconds (default 0.3)")
+      ->type_name("S")
+      ->check(positive_up_to(std::numeric_limits<double>::max()));
+  cmd->add_option("--reference", opt.reference_dir, "the references' folder (default: data/reference)")
+      ->type_name("DIR");
+  cmd->add_flag("--full-outputs", opt.full_outputs,
+                "also compute the scene's per-floor peaks and energy ledger (default: only what the table needs, "
+                "as a study run does)");
+  cmd->add_flag("--json", a->as_json, "print JSON: one object for a single line, else {\"lines\": [...]}");
+  cmd->add_option("--csv", a->csv, "also write the lines as CSV")->type_name("FILE");
+}
+
+}  // namespace vines::cli

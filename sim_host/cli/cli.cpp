@@ -1,0 +1,116 @@
+// Shared pieces of the commands: registration, number lists and ranges, Ctrl-C.
+#include "sim_host/cli/cli.hpp"
+
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <utility>
+
+namespace vines::cli {
+
+CLI::App* add_command(CLI::App& vines, const std::string& name, const std::string& summary, const std::string& notes,
+                      std::function<int()> run) {
+  CLI::App* cmd = vines.add_subcommand(name, summary);
+  cmd->footer(notes);
+  cmd->callback([run = std::move(run)] {
+    const int status = run();
+    if (status != kOk) throw CLI::RuntimeError(status);  // main returns it
+  });
+  return cmd;
+}
+
+namespace {
+
+// "a,b,c" -> *xs: every item a finite number > 0 (with whole: an integer from
+// lo to hi); else the reason, naming the list.
+std::string parse_list(const std::string& text, bool whole, double lo, double hi, std::vector<double>* xs) {
+  xs->clear();
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0))
+      return "not a list of positive numbers: " + text;
+    if (whole && (x != std::floor(x) || x < lo || x > hi)) {
+      char range[64];
+      std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+      return "not a list of integers in " + std::string(range) + ": " + text;
+    }
+    xs->push_back(x);
+    if (comma == std::string::npos) return "";
+    start = comma + 1;
+  }
+}
+
+CLI::Option* add_list(CLI::App& cmd, const std::string& name, bool whole, double lo, double hi,
+                      std::function<void(const std::vector<double>&)> store, const std::string& help) {
+  const auto check = [=](std::string& text) {
+    std::vector<double> xs;
+    return parse_list(text, whole, lo, hi, &xs);
+  };
+  const auto set = [=](const std::string& text) {
+    std::vector<double> xs;
+    parse_list(text, whole, lo, hi, &xs);  // checked above
+    store(xs);
+  };
+  return cmd.add_option_function<std::string>(name, set, help)->type_name("LIST")->check(CLI::Validator(check, ""));
+}
+
+// A bound as a message shows it: whole numbers in full (1000000, not 1e+06).
+std::string number_text(double x) {
+  char s[32];
+  std::snprintf(s, sizeof s, x == std::floor(x) && std::fabs(x) < 1e18 ? "%.0f" : "%g", x);
+  return s;
+}
+
+std::atomic<bool> g_stop{false};
+
+}  // namespace
+
+CLI::Option* add_number_list(CLI::App& cmd, const std::string& name, std::vector<double>* out, const std::string& help) {
+  return add_list(cmd, name, false, 0, 0, [out](const std::vector<double>& xs) { *out = xs; }, help);
+}
+
+CLI::Option* add_number_list(CLI::App& cmd, const std::string& name, std::vector<int>* out, int lo, int hi,
+                             const std::string& help) {
+  return add_list(
+      cmd, name, true, lo, hi, [out](const std::vector<double>& xs) { out->assign(xs.begin(), xs.end()); }, help);
+}
+
+CLI::Validator number_in(double lo, double hi) {
+  const std::string range = hi < 1e18 ? "from " + number_text(lo) + " to " + number_text(hi) : ">= " + number_text(lo);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double x = std::strtod(text.c_str(), &end);
+        if (!text.empty() && *end == '\0' && x >= lo && x <= hi) return "";
+        return "not a number " + range + ": " + text;
+      },
+      "");
+}
+
+CLI::Validator positive_up_to(double hi) {
+  const std::string range =
+      hi < std::numeric_limits<double>::max() ? "in (0, " + number_text(hi) + "]" : "> 0";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double x = std::strtod(text.c_str(), &end);
+        if (!text.empty() && *end == '\0' && x > 0 && x <= hi) return "";
+        return "not a number " + range + ": " + text;
+      },
+      "");
+}
+
+const std::atomic<bool>* stop_on_interrupt() {
+  std::signal(SIGINT, [](int) {
+    g_stop = true;
+    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends at once
+  });
+  return &g_stop;
+}
+
+}  // namespace vines::cli

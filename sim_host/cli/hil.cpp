@@ -1,0 +1,248 @@
+// `vines hil SCENE.toml`: the hardware-in-the-loop bench around `vines node`.
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim_host/cli/cli.hpp"
+#include "sim_host/hil.hpp"
+#include "sim_host/scene.hpp"
+
+namespace vines::cli {
+namespace {
+
+struct HilArgs {
+  std::string scene_path;
+  host::HilOptions opt;
+  bool as_json = false;
+};
+
+// The hil report as text.
+void print_hil(const nlohmann::json& j) {
+  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", j["scene"].get<std::string>().c_str(),
+              j["mode"].get<std::string>().c_str(), j["clock"].get<std::string>().c_str(),
+              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>(),
+              j["node"].get<std::string>().c_str());
+  const auto& nd = j["node_deadline"];
+  std::printf("  node deadline monitor: %lld overruns of a %lld-tick budget, worst step %lld ticks (k %lld)",
+              nd["overruns"].get<long long>(), nd["budget_ticks"].get<long long>(), nd["worst_ticks"].get<long long>(),
+              nd["worst_k"].get<long long>());
+  if (j.contains("worst_step_instructions"))
+    std::printf("; %.0f instructions (median %.0f)", j["worst_step_instructions"].get<double>(),
+                j["median_step_instructions"].get<double>());
+  if (nd["stack_peak_bytes"].get<long long>() > 0) std::printf("; stack %lld B", nd["stack_peak_bytes"].get<long long>());
+  std::printf("\n");
+  std::printf("  steps %lld of %lld, deadline misses %lld (deadline %.3g ms)", j["steps"].get<long long>(),
+              j["samples"].get<long long>(), j["deadline_misses"].get<long long>(), 1e3 * j["deadline_s"].get<double>());
+  if (!j["latency_us"].is_null())
+    std::printf(", latency mean %.0f us, p99 %.0f us, max %.0f us", j["latency_us"]["mean"].get<double>(),
+                j["latency_us"]["p99"].get<double>(), j["latency_us"]["max"].get<double>());
+  std::printf("\n  faults injected %lld, detected %lld, survived %lld; node restarts %lld\n",
+              j["faults_injected"].get<long long>(), j["faults_detected"].get<long long>(),
+              j["faults_survived"].get<long long>(), j["node_restarts"].get<long long>());
+  for (const auto& [name, c] : j["faults"].items())
+    std::printf("    %-10s injected %5lld  detected %5lld  survived %5lld\n", name.c_str(), c["injected"].get<long long>(),
+                c["detected"].get<long long>(), c["survived"].get<long long>());
+  std::printf("  max deviation from offline %.3g m%s; outputs finite: %s\n", j["max_deviation_from_offline"].get<double>(),
+              j["bit_exact"].get<bool>() ? " (bit for bit equal)" : "", j["outputs_finite"].get<bool>() ? "yes" : "NO");
+  if (j.contains("twin")) {
+    const auto& t = j["twin"];
+    std::printf("  twin: eta_k %.3g, residual RMS %.4g m/s^2 (max %.4g), residual alarm %lld steps", 
+                t["truth_stiffness_scale"].get<double>(), t["residual_rms_mps2"].get<double>(),
+                t["residual_max_mps2"].get<double>(), t["residual_alarm_steps"].get<long long>());
+    if (!t["first_residual_alarm_s"].is_null()) std::printf(" from %.2f s", t["first_residual_alarm_s"].get<double>());
+    std::printf(", drift alarm %lld steps\n", t["drift_alarm_steps"].get<long long>());
+  }
+  if (j.contains("hybrid")) {
+    const auto& hy = j["hybrid"];
+    std::printf("  hybrid: compensation %.2f ms (order %d): tracking RMS %.3g mm, peak %.3g mm; top floor vs pure "
+                "simulation RMS %.3g mm, peak %.3g mm (peaks %.4f / %.4f m)\n",
+                1e3 * hy["compensation_delay_s"].get<double>(), hy["compensation_order"].get<int>(),
+                1e3 * hy["tracking_rms_m"].get<double>(), 1e3 * hy["tracking_peak_m"].get<double>(),
+                1e3 * hy["top_diff_from_pure_rms_m"].get<double>(), 1e3 * hy["top_diff_from_pure_peak_m"].get<double>(),
+                hy["peak_top_hybrid_m"].get<double>(), hy["peak_top_pure_m"].get<double>());
+  }
+}
+
+int hil(const HilArgs& a) {
+  const host::Scene scene = host::load_scene(a.scene_path);
+  const nlohmann::json j = host::run_hil(scene, a.opt);
+  if (a.as_json) std::printf("%s\n", j.dump().c_str());
+  else print_hil(j);
+  return j["outputs_finite"].get<bool>() ? kOk : kRefused;
+}
+
+// What each fault option injects at the samples SPEC picks.
+const char* fault_help(host::FaultKind k) {
+  using host::FaultKind;
+  switch (k) {
+    case FaultKind::kDrop: return "sample frames not sent";
+    case FaultKind::kCorrupt: return "a byte of the sample frame flipped";
+    case FaultKind::kDuplicate: return "sample frames sent twice";
+    case FaultKind::kReorder: return "a sample frame sent after the next one";
+    case FaultKind::kLate: return "samples sent --late-periods periods late";
+    case FaultKind::kNonFinite: return "NaN or inf samples";
+    case FaultKind::kStall: return "the link silent for --stall-periods periods, their samples sent after";
+    case FaultKind::kRestart: return "kill the node, start a new one";
+    default: return "";
+  }
+}
+
+}  // namespace
+
+void add_hil(CLI::App& vines) {
+  using host::FaultKind;
+  auto a = std::make_shared<HilArgs>();
+  host::HilOptions& opt = a->opt;
+  CLI::App* cmd = add_command(
+      vines, "hil",
+      "Hardware-in-the-loop bench: streams the scene's record at its sensor rate to the firmware node (`vines node` "
+      "as a child process, over pipes, protocol in docs/link_protocol.md), injects faults, checks deadlines and "
+      "reports steps, deadline misses, latency, faults injected/detected/survived and the largest deviation of the "
+      "telemetry from the offline run (bit for bit equal without faults); digital-twin monitor and shake-table "
+      "(hybrid) modes.",
+      "SPEC of a fault: a rate per sample from 0 to 1, or @K1,K2,... sample indices.", [a] { return hil(*a); });
+  cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
+  cmd->add_option("--mode", opt.mode, "replay (default), twin (digital-twin monitor), hybrid (shake table)")
+      ->type_name("replay|twin|hybrid")
+      ->check(CLI::IsMember({"replay", "twin", "hybrid"}));
+  cmd->add_flag("--realtime,!--virtual-clock", opt.realtime,
+                "pace samples at the sensor rate on the wall clock; or (default) lock step, as fast as the link "
+                "allows (the node's clock is the samples' stamps)");
+  cmd->add_option("--duration", opt.duration_s, "first S seconds of the record only")
+      ->type_name("S")
+      ->check(number_in(1e-6, 1e6));
+  cmd->add_flag("--json", a->as_json, "print one JSON object");
+  cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE");
+  cmd->add_option("--timeout", opt.timeout_s, "longest wait for the node (default 5, 60 with QEMU)")
+      ->type_name("S")
+      ->check(number_in(0.01, 3600));
+  cmd->add_option("--deadline", opt.deadline_periods, "telemetry due P sensor periods after its sample (default 1)")
+      ->type_name("PERIODS")
+      ->check(number_in(0.01, 1e6));
+  cmd->add_option_function<std::string>(
+         "--node",
+         [&opt](const std::string& v) {
+           const std::vector<std::string> names = host::node_names();
+           if (std::find(names.begin(), names.end(), v) != names.end()) {
+             opt.node = v;
+           } else if (v.rfind("qemu:", 0) == 0) {
+             std::string known;
+             for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+             throw CLI::ValidationError("--node", v + ": not a node (" + known + ", or a program's path)");
+           } else {
+             opt.node_command = v;
+           }
+         },
+         "host (default: `vines node`), qemu:cortex-m4f or qemu:cortex-m7 (the board image in QEMU, float / "
+         "double, instructions counted; build the preset first), or the path of a node program")
+      ->type_name("N");
+  cmd->add_option("--image", opt.image,
+                  "the board image to run (default: build/TARGET/firmware/app/vines_node_DEVICE.elf)")
+      ->type_name("ELF");
+  cmd->add_option("--budget-ticks", opt.budget_ticks,
+                  "the node's deadline budget in its counter ticks (ns on the host, 25 MHz on a board; default one "
+                  "sensor period): overruns reported")
+      ->type_name("T")
+      ->check(number_in(1, 4e9));
+
+  const std::string faults = "fault options";
+  for (int f = 0; f < host::kFaultKinds; ++f) {
+    const auto kind = static_cast<FaultKind>(f);
+    if (kind == FaultKind::kSaturate) continue;  // a sensor range, not a SPEC
+    const std::string name = std::string("--") + host::fault_kind_name(kind);
+    cmd->add_option_function<std::string>(
+           name,
+           [&opt, f, name](const std::string& v) {
+             try {
+               opt.faults[f] = host::parse_fault_spec(name, v);
+             } catch (const std::exception& e) {
+               throw CLI::ValidationError(e.what(), CLI::ExitCodes::ValidationError);
+             }
+           },
+           fault_help(kind))
+        ->type_name("SPEC")
+        ->group(faults);
+  }
+  cmd->add_option("--late-periods", opt.late_periods, "how late --late sends (default 3)")
+      ->type_name("L")
+      ->check(number_in(1, 1e5))
+      ->group(faults);
+  cmd->add_option("--stall-periods", opt.stall_periods, "how long --stall lasts (default 20)")
+      ->type_name("S")
+      ->check(number_in(1, 1e5))
+      ->group(faults);
+  cmd->add_option("--saturate", opt.saturate_g, "sensor range [g]")
+      ->type_name("G")
+      ->check(number_in(1e-6, 100))
+      ->group(faults);
+  cmd->add_option("--seed", opt.seed, "draws of the rates (default 1)")
+      ->type_name("N")
+      ->check(number_in(0, 1e15))
+      ->group(faults);
+  cmd->add_option("--grace", opt.grace_periods, "node: a missing sample held after P periods (default 1.5)")
+      ->type_name("P")
+      ->check(number_in(0.5, 1000))
+      ->group(faults);
+  cmd->add_option("--node-stall", opt.node_stall_periods, "node: stall reported after P periods (default 10)")
+      ->type_name("P")
+      ->check(number_in(1, 1e6))
+      ->group(faults);
+
+  const std::string twin = "twin options";
+  cmd->add_option("--truth-stiffness-scale", opt.truth_stiffness_scale, "the measured building's eta_k (default 1)")
+      ->type_name("ETA")
+      ->check(number_in(0.01, 10))
+      ->group(twin);
+  cmd->add_option("--measure-noise", opt.measure_noise_mps2, "measurement noise (m/s^2 RMS, default 0)")
+      ->type_name("A")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--drift-limit", opt.drift_limit_m, "drift alarm, every story (m; default 0: none)")
+      ->type_name("M")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--residual-limit", opt.residual_limit_mps2, "RMS residual alarm threshold (default 0.05 m/s^2)")
+      ->type_name("A")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--residual-window", opt.residual_window_s, "window of the RMS residual (s, default 1)")
+      ->type_name("S")
+      ->check(number_in(1e-6, 1e6))
+      ->group(twin);
+
+  const std::string hybrid = "hybrid options";
+  cmd->add_option("--actuator-hz", opt.actuator_hz, "natural frequency of the actuator, a second-order servo (Hz, default 20)")
+      ->type_name("F")
+      ->check(number_in(0.1, 1e4))
+      ->group(hybrid);
+  cmd->add_option("--actuator-zeta", opt.actuator_zeta, "its damping ratio (default 0.7)")
+      ->type_name("Z")
+      ->check(number_in(0.01, 10))
+      ->group(hybrid);
+  cmd->add_option("--actuator-delay", opt.actuator_delay_s, "its pure delay (s, default 0.005)")
+      ->type_name("S")
+      ->check(number_in(0, 1))
+      ->group(hybrid);
+  cmd->add_option("--force-noise", opt.force_noise_n, "load cell noise (N, default 50)")
+      ->type_name("N")
+      ->check(number_in(0, 1e9))
+      ->group(hybrid);
+  cmd->add_option("--force-lsb", opt.force_lsb_n, "load cell resolution (N, default 10)")
+      ->type_name("N")
+      ->check(number_in(0, 1e9))
+      ->group(hybrid);
+  cmd->add_option("--comp-delay", opt.comp_delay_s, "delay compensated (s; default: delay + 2 zeta/w; 0: none)")
+      ->type_name("S")
+      ->check(number_in(0, 1))
+      ->group(hybrid);
+  cmd->add_option("--comp-order", opt.comp_order, "order of the compensation (1-3, default 2)")
+      ->type_name("P")
+      ->check(number_in(1, 3))
+      ->group(hybrid);
+}
+
+}  // namespace vines::cli

@@ -1,0 +1,78 @@
+// `vines sweep SPEC.toml`: the grid of runs of a study spec, on threads and MPI ranks.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim_host/cli/cli.hpp"
+#include "sim_host/sweep.hpp"
+#include "sim_host/sweep_mpi.hpp"
+
+namespace vines::cli {
+namespace {
+
+struct SweepArgs {
+  std::string spec_path;
+  host::SweepOptions opt;
+};
+
+int sweep(SweepArgs a) {
+  using namespace vines::host;
+  SweepOptions& opt = a.opt;
+  Mpi mpi;
+  const SweepSpec spec = load_sweep(a.spec_path);
+  const std::vector<RunPlan> plan = plan_runs(spec);
+  if (opt.out_dir.empty()) opt.out_dir = "out/" + std::filesystem::path(a.spec_path).stem().string();
+  const std::atomic<bool>* stop = stop_on_interrupt();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<RunResult> results =
+      execute(spec, plan, opt.threads, mpi.rank(), mpi.size(), stop, opt.progress && mpi.rank() == 0);
+  mpi.gather(&results);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (mpi.rank() != 0) return kOk;
+  const nlohmann::json s = write_sweep(spec, plan, results, opt.out_dir, wall);
+  std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
+              a.spec_path.c_str(), s["done"].get<std::size_t>(), plan.size(), wall, s["runs_per_s"].get<double>(),
+              mpi.size(), mpi.size() > 1 ? "s" : "", s["failed"].get<std::size_t>(), opt.out_dir.c_str());
+  for (const auto& st : s["studies"]) {
+    if (st["x_r"].is_null()) continue;
+    std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f",
+                st["name"].get<std::string>().c_str(), st["device"].get<std::string>().c_str(),
+                st["runs"].get<std::size_t>(), 100 * st["x_r"]["mean"].get<double>(),
+                100 * st["x_r"]["sd"].get<double>(), 100 * st["x_r"]["min"].get<double>(),
+                100 * st["x_r"]["max"].get<double>(), 100 * st["E_r"]["mean"].get<double>(),
+                100 * st["E_r"]["sd"].get<double>());
+    if (st.contains("best"))
+      std::printf("  best %s = %g", st["best"]["key"].get<std::string>().c_str(), st["best"]["value"].get<double>());
+    std::printf("\n");
+  }
+  if (*stop) {
+    std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s["done"].get<std::size_t>());
+    return kInterrupted;
+  }
+  return s["failed"].get<std::size_t>() == 0 ? kOk : kRefused;
+}
+
+}  // namespace
+
+void add_sweep(CLI::App& vines) {
+  auto a = std::make_shared<SweepArgs>();
+  CLI::App* cmd = add_command(vines, "sweep",
+                              "Run the grid of scenes a study spec describes (data/studies/*.toml) on all cores (or "
+                              "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv and "
+                              "DIR/summary.json.",
+                              "Ctrl-C stops after the runs under way and keeps what finished (exit status 130).",
+                              [a] { return sweep(*a); });
+  cmd->add_option("SPEC.toml", a->spec_path,
+                  "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
+      ->required();
+  cmd->add_option("--out", a->opt.out_dir, "output folder (default: out/<spec name>)")->type_name("DIR");
+  cmd->add_option("--threads", a->opt.threads, "worker threads (default: all cores; per rank under MPI)")
+      ->type_name("N")
+      ->check(number_in(1, 1024));
+  cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr");
+}
+
+}  // namespace vines::cli
