@@ -11,6 +11,9 @@ Layers (see the README of each folder):
   board app   firmware/app        core, HAL facades, its own files, same C++
   mcu backend hal/mcu             core, HAL facades, its own files (any C/C++
                                   header: the link proves there is no heap)
+  core tests  tests/core          core, its own files, the link fuzz body
+                                  (tests/fuzz), GoogleTest and the C++ standard
+                                  library: no host code, no other library
   host        hal/host, sim_host,  anything
               tests, tools
 No layer above may include host code (sim_host/, hal/host/, host/...), and
@@ -30,12 +33,18 @@ def core_angle(name):
     return name in CORE_STD or name.startswith("Eigen/")
 
 
+def core_test_angle(name):
+    # GoogleTest, Eigen, and standard headers (<vector>, <memory>: no path, no extension).
+    return name.startswith(("gtest/", "Eigen/")) or ("/" not in name and "." not in name)
+
+
 # layer: (folder, quoted-include roots searched, angle-include rule)
 LAYERS = [
     ("core", "firmware/include", ["firmware/include"], core_angle),
     ("hal facade", "hal/include", ["hal/include"], core_angle),
     ("board app", "firmware/app", ["firmware/include", "hal/include"], core_angle),
     ("mcu backend", "hal/mcu", ["firmware/include", "hal/include"], lambda name: True),
+    ("core tests", "tests/core", ["firmware/include", "tests/fuzz"], core_test_angle),
 ]
 HOST_PREFIXES = ("sim_host/", "hal/host/", "host/")
 

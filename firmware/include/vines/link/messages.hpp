@@ -1,12 +1,13 @@
-// Payloads of the link's messages (docs/link_protocol.md), with their
-// encoders (returning the payload length, 0 if it does not fit) and decoders
-// (false on any length or range mismatch: a frame whose CRC passed can still
-// be refused here).
+// Payloads of the link's messages (docs/link_protocol.md), their wire layouts
+// (one list of fields per message for both directions), and the encoders
+// (returning the payload length, 0 if it does not fit) and decoders (false on
+// any length or range mismatch: a frame whose CRC passed can still be refused
+// here) built on them.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <initializer_list>
+#include <utility>
 
 #include "vines/link/wire.hpp"
 #include "vines/params.hpp"
@@ -123,148 +124,103 @@ struct Fault {
   std::uint32_t count = 1;
 };
 
+// Wire layouts ---------------------------------------------------------------
+// Each message's fields in wire order, written once for both directions: `io`
+// is a Writer (encode, `m` const) or a Reader (decode), whose field() reads or
+// writes one value and whose checks (enumeration, count, text, tail) refuse a
+// value out of range on either side.
+
+template <class IO, class M>
+void layout(IO& io, M& c, ConfigureChunk*) {
+  io.enumeration(c.part, ConfigPart::kModelImage);
+  io.field(c.offset);
+  io.field(c.total);
+  io.field(c.blob_crc);
+  io.tail(c.data, c.length, kChunk);  // the chunk's bytes: the rest of the payload
+}
+// A chunk lies inside its part.
+inline bool holds(const ConfigureChunk& c) { return static_cast<std::uint64_t>(c.offset) + c.length <= c.total; }
+
+template <class IO, class M>
+void layout(IO& io, M& s, Start*) {
+  io.field(s.k0);
+  io.field(s.t_ns);
+}
+
+template <class IO, class M>
+void layout(IO& io, M& s, Sample*) {
+  io.field(s.k);
+  io.field(s.t_ns);
+  io.field(s.ag);
+  io.field(s.aux);
+}
+
+template <class IO, class M>
+void layout(IO& io, M& t, Telemetry*) {
+  io.field(t.rx);
+  io.field(t.k);
+  io.field(t.flags);
+  io.count(t.n, kMaxStories);  // the stories that follow: 1..kMaxStories
+  io.field(t.contact_mode);
+  io.field(t.ag);
+  for (int i = 0; i < t.n && i < kMaxStories; ++i) io.field(t.x[i]);
+  io.field(t.acc_top);
+  io.field(t.elastic_energy);
+  io.field(t.particle_x);
+  io.field(t.particle_v);
+  io.field(t.contact_force);
+  io.field(t.dissipated);
+  io.field(t.aux);
+  io.field(t.drift_alarms);
+  io.field(t.step_ticks);
+}
+
+template <class IO, class M>
+void layout(IO& io, M& s, Status*) {
+  io.field(s.rx);
+  io.enumeration(s.state, NodeState::kStopped);
+  io.field(s.cold_start);
+  io.field(s.next_k);
+  io.field(s.steps);
+  io.constant(static_cast<std::uint8_t>(kFaultCodes));  // the fault counts that follow
+  for (auto& f : s.faults) io.field(f);
+  io.text(s.message);  // length byte, then the characters
+  io.field(s.timing.counter_hz);
+  io.field(s.timing.budget_ticks);
+  io.field(s.timing.overruns);
+  io.field(s.timing.worst_ticks);
+  io.field(s.timing.worst_k);
+  io.field(s.timing.stack_peak_bytes);
+}
+
+template <class IO, class M>
+void layout(IO& io, M& f, Fault*) {
+  io.field(f.rx);
+  io.enumeration(f.code, static_cast<FaultCode>(kFaultCodes - 1));
+  io.field(f.k);
+  io.field(f.count);
+}
+
+// Checks a decoded message beyond its fields' own ranges (by default none).
+template <class M>
+bool holds(const M&) { return true; }
+
 // Encoders / decoders ------------------------------------------------------
+// encode: the payload length, 0 if it does not fit or a value is out of
+// range. decode: false on any length or range mismatch.
 
-inline std::size_t encode(const ConfigureChunk& c, std::uint8_t* b, std::size_t cap) {
+template <class M, class = decltype(layout(std::declval<Writer&>(), std::declval<const M&>(), static_cast<M*>(nullptr)))>
+std::size_t encode(const M& m, std::uint8_t* b, std::size_t cap) {
   Writer w(b, cap);
-  w.u8(static_cast<std::uint8_t>(c.part));
-  w.u32(c.offset);
-  w.u32(c.total);
-  w.u32(c.blob_crc);
-  w.bytes(c.data, c.length);
+  layout(w, m, static_cast<M*>(nullptr));
   return w.ok() ? w.size() : 0;
 }
-inline bool decode(const std::uint8_t* p, std::size_t n, ConfigureChunk* c) {
-  Reader r(p, n);
-  const std::uint8_t part = r.u8();
-  c->offset = r.u32();
-  c->total = r.u32();
-  c->blob_crc = r.u32();
-  if (!r.ok() || r.remaining() > kChunk || part > static_cast<std::uint8_t>(ConfigPart::kModelImage)) return false;
-  c->part = static_cast<ConfigPart>(part);
-  c->length = static_cast<std::uint16_t>(r.remaining());
-  c->data = r.bytes(c->length);
-  return r.done() && static_cast<std::uint64_t>(c->offset) + c->length <= c->total;
-}
 
-inline std::size_t encode(const Start& s, std::uint8_t* b, std::size_t cap) {
-  Writer w(b, cap);
-  w.u32(s.k0);
-  w.u64(s.t_ns);
-  return w.ok() ? w.size() : 0;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, Start* s) {
+template <class M, class = decltype(layout(std::declval<Reader&>(), std::declval<M&>(), static_cast<M*>(nullptr)))>
+bool decode(const std::uint8_t* p, std::size_t n, M* m) {
   Reader r(p, n);
-  s->k0 = r.u32();
-  s->t_ns = r.u64();
-  return r.done();
-}
-
-inline std::size_t encode(const Sample& s, std::uint8_t* b, std::size_t cap) {
-  Writer w(b, cap);
-  w.u32(s.k);
-  w.u64(s.t_ns);
-  w.f64(s.ag);
-  w.f64(s.aux);
-  return w.ok() ? w.size() : 0;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, Sample* s) {
-  Reader r(p, n);
-  s->k = r.u32();
-  s->t_ns = r.u64();
-  s->ag = r.f64();
-  s->aux = r.f64();
-  return r.done();
-}
-
-inline std::size_t encode(const Telemetry& t, std::uint8_t* b, std::size_t cap) {
-  Writer w(b, cap);
-  w.u32(t.rx);
-  w.u32(t.k);
-  w.u16(t.flags);
-  w.u8(t.n);
-  w.u8(t.contact_mode);
-  w.f64(t.ag);
-  for (int i = 0; i < t.n && i < kMaxStories; ++i) w.f64(t.x[i]);
-  for (double v : {t.acc_top, t.elastic_energy, t.particle_x, t.particle_v, t.contact_force, t.dissipated, t.aux})
-    w.f64(v);
-  w.u64(t.drift_alarms);
-  w.u32(t.step_ticks);
-  return w.ok() && t.n <= kMaxStories ? w.size() : 0;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, Telemetry* t) {
-  Reader r(p, n);
-  t->rx = r.u32();
-  t->k = r.u32();
-  t->flags = r.u16();
-  t->n = r.u8();
-  t->contact_mode = r.u8();
-  if (t->n < 1 || t->n > kMaxStories) return false;
-  t->ag = r.f64();
-  for (int i = 0; i < t->n; ++i) t->x[i] = r.f64();
-  for (double* v : {&t->acc_top, &t->elastic_energy, &t->particle_x, &t->particle_v, &t->contact_force,
-                    &t->dissipated, &t->aux})
-    *v = r.f64();
-  t->drift_alarms = r.u64();
-  t->step_ticks = r.u32();
-  return r.done();
-}
-
-inline std::size_t encode(const Status& s, std::uint8_t* b, std::size_t cap) {
-  Writer w(b, cap);
-  w.u32(s.rx);
-  w.u8(static_cast<std::uint8_t>(s.state));
-  w.u8(s.cold_start);
-  w.u32(s.next_k);
-  w.u32(s.steps);
-  w.u8(static_cast<std::uint8_t>(kFaultCodes));
-  for (std::uint32_t f : s.faults) w.u32(f);
-  std::size_t len = 0;
-  while (len < sizeof s.message && s.message[len] != '\0') ++len;
-  w.u8(static_cast<std::uint8_t>(len));
-  w.bytes(reinterpret_cast<const std::uint8_t*>(s.message), len);
-  const StepTiming& t = s.timing;
-  for (std::uint32_t v : {t.counter_hz, t.budget_ticks, t.overruns, t.worst_ticks, t.worst_k, t.stack_peak_bytes}) w.u32(v);
-  return w.ok() ? w.size() : 0;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, Status* s) {
-  Reader r(p, n);
-  s->rx = r.u32();
-  const std::uint8_t state = r.u8();
-  s->cold_start = r.u8();
-  s->next_k = r.u32();
-  s->steps = r.u32();
-  if (r.u8() != kFaultCodes || state > static_cast<std::uint8_t>(NodeState::kStopped)) return false;
-  s->state = static_cast<NodeState>(state);
-  for (std::uint32_t& f : s->faults) f = r.u32();
-  const std::uint8_t len = r.u8();
-  if (len >= sizeof s->message) return false;
-  const std::uint8_t* m = r.bytes(len);
-  StepTiming& t = s->timing;
-  for (std::uint32_t* v : {&t.counter_hz, &t.budget_ticks, &t.overruns, &t.worst_ticks, &t.worst_k, &t.stack_peak_bytes})
-    *v = r.u32();
-  if (!r.done()) return false;
-  for (std::size_t i = 0; i < sizeof s->message; ++i) s->message[i] = i < len ? static_cast<char>(m[i]) : '\0';
-  return true;
-}
-
-inline std::size_t encode(const Fault& f, std::uint8_t* b, std::size_t cap) {
-  Writer w(b, cap);
-  w.u32(f.rx);
-  w.u8(static_cast<std::uint8_t>(f.code));
-  w.u32(f.k);
-  w.u32(f.count);
-  return w.ok() ? w.size() : 0;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, Fault* f) {
-  Reader r(p, n);
-  f->rx = r.u32();
-  const std::uint8_t code = r.u8();
-  f->k = r.u32();
-  f->count = r.u32();
-  if (code >= kFaultCodes) return false;
-  f->code = static_cast<FaultCode>(code);
-  return r.done();
+  layout(r, *m, static_cast<M*>(nullptr));
+  return r.done() && holds(*m);
 }
 
 inline const char* fault_name(FaultCode c) {

@@ -33,6 +33,41 @@ class Writer {
   std::size_t size() const { return len_; }
   bool ok() const { return !overflow_; }
 
+  // The wire layouts' operations (messages.hpp), the Reader's mirror images:
+  // a value out of its range sets the sticky flag, as an overflow does.
+  void field(std::uint8_t v) { u8(v); }
+  void field(std::uint16_t v) { u16(v); }
+  void field(std::uint32_t v) { u32(v); }
+  void field(std::uint64_t v) { u64(v); }
+  void field(double v) { f64(v); }
+  // An enumeration as one byte, 0..last.
+  template <class E>
+  void enumeration(E v, E last) {
+    if (static_cast<std::uint8_t>(v) > static_cast<std::uint8_t>(last)) overflow_ = true;
+    u8(static_cast<std::uint8_t>(v));
+  }
+  // A count of what follows, 1..max.
+  void count(std::uint8_t n, int max) {
+    if (n < 1 || n > max) overflow_ = true;
+    u8(n);
+  }
+  // A byte both sides know (a table's length): the reader refuses another.
+  void constant(std::uint8_t v) { u8(v); }
+  // A NUL-terminated text shorter than its buffer: length byte, characters.
+  template <std::size_t L>
+  void text(const char (&s)[L]) {
+    std::size_t len = 0;
+    while (len < L && s[len] != '\0') ++len;
+    if (len >= L || len > 255) overflow_ = true;
+    u8(static_cast<std::uint8_t>(len));
+    bytes(reinterpret_cast<const std::uint8_t*>(s), len < L ? len : 0);
+  }
+  // The rest of the payload: n bytes, at most max.
+  void tail(const std::uint8_t* p, std::uint16_t n, std::size_t max) {
+    if (n > max) overflow_ = true;
+    bytes(p, n);
+  }
+
  private:
   void put(std::uint64_t v, std::size_t n) {
     if (n > cap_ - len_) {
@@ -73,6 +108,41 @@ class Reader {
   // Everything read was there, and nothing is left over.
   bool done() const { return !error_ && pos_ == n_; }
   bool ok() const { return !error_; }
+
+  // The wire layouts' operations (messages.hpp): see Writer.
+  void field(std::uint8_t& v) { v = u8(); }
+  void field(std::uint16_t& v) { v = u16(); }
+  void field(std::uint32_t& v) { v = u32(); }
+  void field(std::uint64_t& v) { v = u64(); }
+  void field(double& v) { v = f64(); }
+  template <class E>
+  void enumeration(E& v, E last) {
+    const std::uint8_t b = u8();
+    if (b > static_cast<std::uint8_t>(last)) error_ = true;
+    else v = static_cast<E>(b);
+  }
+  void count(std::uint8_t& n, int max) {
+    n = u8();
+    if (n < 1 || n > max) error_ = true;
+  }
+  void constant(std::uint8_t v) {
+    if (u8() != v) error_ = true;
+  }
+  template <std::size_t L>
+  void text(char (&s)[L]) {
+    const std::uint8_t len = u8();
+    const std::uint8_t* m = len < L ? bytes(len) : nullptr;
+    if (len >= L) error_ = true;
+    for (std::size_t i = 0; i < L; ++i) s[i] = m && i < len ? static_cast<char>(m[i]) : '\0';
+  }
+  void tail(const std::uint8_t*& p, std::uint16_t& n, std::size_t max) {
+    if (error_ || remaining() > max) {
+      error_ = true;
+      return;
+    }
+    n = static_cast<std::uint16_t>(remaining());
+    p = bytes(n);
+  }
 
  private:
   std::uint64_t get(std::size_t n) {

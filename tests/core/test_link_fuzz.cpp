@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "fuzz/link_fuzz_body.hpp"
+#include "link_fuzz_body.hpp"
 
 namespace vines::link {
 namespace {
