@@ -109,12 +109,14 @@ QUICK_DURATION_S = 3.0
 SCENES = os.path.join(ROOT, "data", "scenes")
 
 
+# A user error, a missing tool or an input that cannot be used: mcu_report.py prints it, exits 1.
 class Failure(Exception):
     pass
 
 
 # ---- images: sizes and call-graph stack bound -------------------------------
 
+# One program of the Arm toolchain: its output, or a Failure with its error.
 def _tool(name, *args):
     try:
         return subprocess.run([name, *args], capture_output=True, text=True, check=True).stdout
@@ -124,6 +126,8 @@ def _tool(name, *args):
         raise Failure(f"{name} {' '.join(args)}: {e.stderr.strip()}")
 
 
+# Flash and RAM of one image from its sections (arm-none-eabi-size -A) and the linker's
+# stack symbols (arm-none-eabi-nm); the guard below the stack is not counted as RAM.
 def sizes(elf):
     sec = {}
     for line in _tool("arm-none-eabi-size", "-A", elf).splitlines():
@@ -173,6 +177,8 @@ def call_graph(objdir):
     return frames, edges, dynamic
 
 
+# The deepest stack from root down the call graph, with the dynamic frames on it, the
+# callees without call-graph info and the functions on a cycle.
 def worst_stack(objdir, root="vines_start"):
     frames, edges, dynamic = call_graph(objdir)
     memo, unknown, cycles = {}, set(), set()
@@ -193,6 +199,7 @@ def worst_stack(objdir, root="vines_start"):
     return total, sorted(dynamic & set(memo)), sorted(unknown), sorted(cycles)
 
 
+# A file's SHA-256, first 16 hex digits (None if unreadable): which image was sized, which ran.
 def file_hash(path):
     try:
         with open(path, "rb") as f:
@@ -201,6 +208,7 @@ def file_hash(path):
         return None
 
 
+# One image as the report lists it: ELF, hash, sizes and the call-graph bound.
 def image_info(target, device):
     build = os.path.join(ROOT, "build", target)
     elf = os.path.join(build, "firmware", "app", f"vines_node_{device}.elf")
@@ -215,6 +223,7 @@ def image_info(target, device):
 
 # ---- scenes -----------------------------------------------------------------
 
+# A TOML file read with tomllib; unreadable or malformed, a Failure naming it.
 def load_toml(path):
     try:
         import tomllib
@@ -229,6 +238,7 @@ def load_toml(path):
         raise Failure(f"{path}: {e}")
 
 
+# One value of a scene in TOML syntax (booleans, numbers, strings, lists of them).
 def toml_value(v):
     if isinstance(v, bool):
         return "true" if v else "false"
@@ -245,6 +255,7 @@ def toml_value(v):
     raise Failure(f"cannot write {v!r} in a scene")
 
 
+# A scene ({table: {key: value}}) written as a TOML file, one table after another.
 def write_scene(path, scene):
     lines = []
     for table, keys in scene.items():
@@ -255,6 +266,8 @@ def write_scene(path, scene):
         f.write("\n".join(lines))
 
 
+# A scene's record path made absolute: beside the scenes, else in the ground-motion
+# folder; else left as written.
 def resolve_record(path, records_dir):
     if os.path.isabs(path):
         return path
@@ -305,9 +318,11 @@ def ic_grid(gap):
             ("u=0 v=+0.5", 0.0, 0.5), ("u=0 v=-1.0", 0.0, -1.0)]
 
 
+# The initial condition of the shipped scene, as the runs name it.
 SCENE_IC = "u=-gap v=0 (left wall)"
 
 
+# The record files of the ground-motion folder to run, --records globs applied.
 def records_list(records_dir, pattern):
     if not os.path.isdir(records_dir):
         raise Failure(f"{records_dir}: no ground-motion folder (--records-dir, or $VINES_GROUND_MOTIONS)")
@@ -365,10 +380,13 @@ def plan(a, tmp, records_dir):
 
 # ---- runs -------------------------------------------------------------------
 
+# The board image of a run: its preset's build of the run's device.
 def image_for(job):
     return os.path.join(ROOT, "build", job["target"], "firmware", "app", f"vines_node_{job['device']}.elf")
 
 
+# One `vines hil` run of the board in QEMU: the figures of its JSON report, or its error;
+# odd lists anything unexpected.
 def run_one(vines, job):
     cmd = [vines, "hil", job["scene_file"], "--node", "qemu:" + job["target"], "--json",
            "--image", image_for(job)]
@@ -426,6 +444,8 @@ def run_one(vines, job):
     return res
 
 
+# Every run, `workers` at once, progress on stderr. False if interrupted: the runs not
+# finished get an error.
 def run_all(vines, jobs, workers):
     # Longest first (samples to stream), for the pool's makespan.
     def est(job):
@@ -472,6 +492,8 @@ def run_all(vines, jobs, workers):
 
 # ---- figures ----------------------------------------------------------------
 
+# The figures of one group of runs on one image (a mode's VI NES runs, or the TMD or
+# bare-frame runs); the same error from several runs once, with a count.
 def figures(runs, image, clock, reference_kind):
     ok = [r for r in runs if "error" not in r]
     errors = {}
@@ -503,6 +525,8 @@ def figures(runs, image, clock, reference_kind):
     return out
 
 
+# One target's report (the JSON object of --json): figures per mode, TMD and bare frame,
+# the images and every run.
 def report(target, jobs, images, a):
     board, scalar, rate, clock = TARGETS[target]
     runs = [j for j in jobs if j["target"] == target]
@@ -534,6 +558,7 @@ def report(target, jobs, images, a):
     return rep
 
 
+# The text lines of one group's figures.
 def fmt_block(name, f, clock):
     lines = [f"  {name}: {f['runs_ok']} runs ok, {f['runs_failed']} failed"]
     for e in f["errors"]:
@@ -558,6 +583,7 @@ def fmt_block(name, f, clock):
     return lines
 
 
+# One target's report as text (without --json).
 def print_text(rep):
     cap = rep["duration_cap_s"]
     print(f"{rep['target']} ({rep['board']}, {rep['scalar']}, {rep['sensor_rate_hz']:g} Hz"
@@ -592,6 +618,8 @@ def print_text(rep):
               + (f"  ({'; '.join(r['odd'])})" if r.get("odd") else ""))
 
 
+# The options checked, the scenes written, the images sized, the runs run and reported;
+# returns the exit status.
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
@@ -672,6 +700,7 @@ def main():
     return 130 if not complete else 1 if failed else 0
 
 
+# A Failure: its message, status 1. Ctrl-C before or after the runs (run_all handles its own): 130.
 if __name__ == "__main__":
     try:
         sys.exit(main())
