@@ -96,22 +96,9 @@ import tempfile
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate figure
-    "cortex-m4f": ("mps2-an386", "float", 1000.0, 168e6),
-    "cortex-m7": ("mps2-an500", "double", 2048.0, 480e6),
-}
-MARGIN = 1.5  # the step must fit in 2/3 of the period
-DEVICES = ("none", "tmd", "vines")
-KINDS = ("scene", "records", "ics", "tmd", "bare")
-PGA_G = 0.35
-QUICK_DURATION_S = 3.0
-SCENES = os.path.join(ROOT, "data", "scenes")
-
-
-# A user error, a missing tool or an input that cannot be used: mcu_report.py prints it, exits 1.
-class Failure(Exception):
-    pass
+# The package mcu/ beside this script, from any working folder.
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mcu import DEVICES, KINDS, MARGIN, PGA_G, QUICK_DURATION_S, ROOT, SCENES, TARGETS, Failure  # noqa: E402
 
 
 # ---- images: sizes and call-graph stack bound -------------------------------
