@@ -1,6 +1,7 @@
 """The parts of tools/mcu_report.py, whose docstring is the user documentation:
-images.py sizes the board images and bounds their stack from the call graph.
-Here: what they share, the repository's root, the targets, the workload's
+images.py sizes the board images and bounds their stack from the call graph
+and scenes.py reads the shipped scenes and writes the runs' scenes. Here:
+what they share, the repository's root, the targets, the workload's
 constants and Failure. Standard library only."""
 import os
 
