@@ -1,9 +1,9 @@
 """The parts of tools/mcu_report.py, whose docstring is the user documentation:
 images.py sizes the board images and bounds their stack from the call graph,
 scenes.py reads the shipped scenes and writes the runs' scenes, runs.py
-plans the runs and drives `vines hil` in QEMU. Here: what they share, the
-repository's root, the targets, the workload's constants and Failure.
-Standard library only."""
+plans the runs and drives `vines hil` in QEMU, report.py turns the runs into
+the figures and prints them. Here: what they share, the repository's root,
+the targets, the workload's constants and Failure. Standard library only."""
 import os
 
 # The repository: tools/mcu/ is two folders down.
