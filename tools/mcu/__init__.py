@@ -1,0 +1,25 @@
+"""The parts of tools/mcu_report.py, whose docstring is the user documentation:
+images.py sizes the board images and bounds their stack from the call graph,
+scenes.py reads the shipped scenes and writes the runs' scenes, runs.py
+plans the runs and drives `vines hil` in QEMU, report.py turns the runs into
+the figures and prints them. Here: what they share, the repository's root,
+the targets, the workload's constants and Failure. Standard library only."""
+import os
+
+# The repository: tools/mcu/ is two folders down.
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate figure
+    "cortex-m4f": ("mps2-an386", "float", 1000.0, 168e6),
+    "cortex-m7": ("mps2-an500", "double", 2048.0, 480e6),
+}
+MARGIN = 1.5  # the step must fit in 2/3 of the period
+DEVICES = ("none", "tmd", "vines")
+KINDS = ("scene", "records", "ics", "tmd", "bare")
+PGA_G = 0.35
+QUICK_DURATION_S = 3.0
+SCENES = os.path.join(ROOT, "data", "scenes")
+
+
+# A user error, a missing tool or an input that cannot be used: mcu_report.py prints it, exits 1.
+class Failure(Exception):
+    pass
