@@ -26,7 +26,21 @@ struct DesignOptions {
 // scene key. Fills key and the default range; false if unknown.
 bool design_parameter(const std::string& name, DesignOptions* opt);
 
-// Runs the search; returns {best: {value, objective}, evaluations: [...]}.
-nlohmann::json optimize_design(const DesignOptions& opt);
+// One value tried: its objective, and in which phase ("grid", "refine").
+struct DesignEvaluation {
+  double value = 0, objective = 0;
+  std::string phase;
+};
+
+// design.json: the search, the best value found and every evaluation.
+struct DesignResult {
+  DesignOptions options;
+  double best_value = 0, best_objective = 0;
+  std::vector<DesignEvaluation> evaluations;
+  nlohmann::json to_json() const;
+};
+
+// Runs the search (the runs of each step through the sweep's parallel map).
+DesignResult optimize_design(const DesignOptions& opt);
 
 }  // namespace vines::host
