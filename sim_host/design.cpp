@@ -28,7 +28,8 @@ std::vector<double> evaluate(const DesignOptions& opt, const std::vector<double>
   st.grid_axes.push_back(axis);
   spec.studies.push_back(st);
   const std::vector<RunPlan> plan = plan_runs(spec);
-  const std::vector<RunResult> res = execute(spec, plan, opt.threads, 0, 1, nullptr, false);
+  const std::vector<RunResult> res = execute(spec, plan, opt.threads, 0, 1, opt.stop, false);
+  if (opt.stop != nullptr && opt.stop->load()) throw DesignInterrupted();
   std::vector<double> out(values.size(), 0.0);
   std::vector<int> count(values.size(), 0);
   for (std::size_t i = 0; i < plan.size(); ++i) {

@@ -49,7 +49,6 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>

@@ -28,7 +28,14 @@ int design(DesignArgs a) {
     throw CLI::ValidationError("--optimize", a.name + ": unknown (a scene key needs --range)");
   const Scene scene = load_scene(opt.scene_path);
   if (a.out_dir.empty()) a.out_dir = "out/design_" + scene.name;
-  const DesignResult r = optimize_design(opt);
+  opt.stop = stop_on_interrupt();
+  DesignResult r;
+  try {
+    r = optimize_design(opt);
+  } catch (const DesignInterrupted&) {
+    std::fprintf(stderr, "vines design: interrupted; nothing written\n");
+    return kInterrupted;
+  }
   std::filesystem::create_directories(a.out_dir);
   const std::filesystem::path file = std::filesystem::path(a.out_dir) / "design.json";
   std::ofstream out(file);
@@ -48,7 +55,8 @@ void add_design(CLI::App& vines) {
   CLI::App* cmd = add_command(vines, "design",
                               "Best value of one design parameter for the scene's record or a set of records (mean "
                               "or worst case): coarse grid, then golden-section refinement.",
-                              "", [a] { return design(*a); });
+                              "Ctrl-C stops the search after the runs under way; nothing is written (exit status 130).",
+                              [a] { return design(*a); });
   cmd->add_option("SCENE.toml", opt.scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--optimize", a->name,
                   "beta (vines.beta, 1.05-2.0), eps (vines.eps, 0.1-1.0), mass_ratio (device.mass_ratio, "
