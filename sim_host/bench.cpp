@@ -9,7 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "sim_host/engine.hpp"
+#include "sim_host/build_engine.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/run.hpp"
 
@@ -21,17 +21,6 @@ using nlohmann::json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double rel(double a, double b) { return b != 0.0 ? std::fabs(a - b) / std::fabs(b) : kNaN; }
-
-// A built engine for the scene, or a runtime_error naming the scene key.
-std::unique_ptr<Engine> built_engine(const Scene& scene, const SceneParams& p, Scalar scalar) {
-  std::unique_ptr<Engine> eng = make_engine(p, scalar);
-  if (!eng)
-    throw std::runtime_error(scene.path + ": frame.stories: this build has frames of " +
-                             std::string(compiled_story_counts()) + " stories");
-  const ParamError e = eng->build(p);
-  if (!e.ok()) throw std::runtime_error(scene.path + ": " + std::string(e.field) + ": " + e.message);
-  return eng;
-}
 
 RunTotals run_once(Engine& eng, const std::vector<double>& a) {
   eng.init(a[0]);
@@ -88,7 +77,7 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   l.scheme = substeps > 0 ? "bounded" : "adaptive";
   l.bounded_substeps = substeps;
   const auto b0 = std::chrono::steady_clock::now();
-  std::unique_ptr<Engine> eng = built_engine(scene, scene.params, scalar);
+  std::unique_ptr<Engine> eng = build_engine(scene.params, scalar, scene.path);
   l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
 
   // Timed runs: median wall time of whole runs (init + every step).
@@ -109,8 +98,8 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   if (scene.params.device.kind != DeviceKind::kNone) {
     SceneParams pb = scene.params;
     pb.device.kind = DeviceKind::kNone;
-    const RunTotals b = run_once(*built_engine(scene, pb, scalar), ex.samples);
-    l.x_r = (b.peak_top - t.peak_top) / b.peak_top;
+    const RunTotals b = run_once(*build_engine(pb, scalar, scene.path), ex.samples);
+    l.x_r = reduction(b.peak_top, t.peak_top);
   }
   set_errors(truth, &l);
   return l;
@@ -141,7 +130,7 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
   l.peak_top = r.peak_top;
   l.elastic_energy = r.elastic_energy;
   l.contacts = r.contacts;
-  l.x_r = truth.has_x_r ? (truth.bare_peak_top - r.peak_top) / truth.bare_peak_top : kNaN;
+  l.x_r = truth.has_x_r ? reduction(truth.bare_peak_top, r.peak_top) : kNaN;
   set_errors(truth, &l);
   return l;
 }

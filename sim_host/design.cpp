@@ -28,7 +28,8 @@ std::vector<double> evaluate(const DesignOptions& opt, const std::vector<double>
   st.grid_axes.push_back(axis);
   spec.studies.push_back(st);
   const std::vector<RunPlan> plan = plan_runs(spec);
-  const std::vector<RunResult> res = execute(spec, plan, opt.threads, 0, 1, nullptr, false);
+  const std::vector<RunResult> res = execute(spec, plan, opt.threads, 0, 1, opt.stop, false);
+  if (opt.stop != nullptr && opt.stop->load()) throw DesignInterrupted();
   std::vector<double> out(values.size(), 0.0);
   std::vector<int> count(values.size(), 0);
   for (std::size_t i = 0; i < plan.size(); ++i) {
@@ -61,10 +62,11 @@ bool design_parameter(const std::string& name, DesignOptions* opt) {
   return opt->lo < opt->hi;  // a raw key needs --range
 }
 
-json optimize_design(const DesignOptions& opt) {
-  json evals = json::array();
+DesignResult optimize_design(const DesignOptions& opt) {
+  DesignResult out;
+  out.options = opt;
   auto record = [&](const std::vector<double>& v, const std::vector<double>& f, const char* phase) {
-    for (std::size_t i = 0; i < v.size(); ++i) evals.push_back({{"value", v[i]}, {"objective", f[i]}, {"phase", phase}});
+    for (std::size_t i = 0; i < v.size(); ++i) out.evaluations.push_back({v[i], f[i], phase});
   };
   // Coarse grid.
   std::vector<double> grid;
@@ -72,7 +74,8 @@ json optimize_design(const DesignOptions& opt) {
   const std::vector<double> fg = evaluate(opt, grid);
   record(grid, fg, "grid");
   const std::size_t b = static_cast<std::size_t>(std::max_element(fg.begin(), fg.end()) - fg.begin());
-  double best_x = grid[b], best_f = fg[b];
+  out.best_value = grid[b];
+  out.best_objective = fg[b];
   // Golden section on the bracket [grid[b-1], grid[b+1]].
   double a = grid[b > 0 ? b - 1 : 0], c = grid[std::min(b + 1, grid.size() - 1)];
   const double g = (std::sqrt(5.0) - 1) / 2;
@@ -93,14 +96,23 @@ json optimize_design(const DesignOptions& opt) {
       record({x2}, {f2}, "refine");
     }
   }
-  for (const auto& e : evals)
-    if (e["objective"].get<double>() > best_f) {
-      best_f = e["objective"];
-      best_x = e["value"];
+  // The best of every evaluation, the first of equals.
+  for (const DesignEvaluation& e : out.evaluations)
+    if (e.objective > out.best_objective) {
+      out.best_objective = e.objective;
+      out.best_value = e.value;
     }
-  return {{"scene", opt.scene_path}, {"key", opt.key}, {"metric", opt.metric}, {"objective", opt.objective},
-          {"records", opt.records}, {"range", {opt.lo, opt.hi}},
-          {"best", {{"value", best_x}, {"objective", best_f}}}, {"evaluations", evals}};
+  return out;
+}
+
+json DesignResult::to_json() const {
+  json evals = json::array();
+  for (const DesignEvaluation& e : evaluations)
+    evals.push_back({{"value", e.value}, {"objective", e.objective}, {"phase", e.phase}});
+  const DesignOptions& o = options;
+  return {{"scene", o.scene_path}, {"key", o.key}, {"metric", o.metric}, {"objective", o.objective},
+          {"records", o.records}, {"range", {o.lo, o.hi}},
+          {"best", {{"value", best_value}, {"objective", best_objective}}}, {"evaluations", evals}};
 }
 
 }  // namespace vines::host

@@ -3,6 +3,8 @@
 // grid, then golden-section refinement of the bracket around the grid's best.
 #pragma once
 
+#include <atomic>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,13 +22,34 @@ struct DesignOptions {
   std::string objective = "mean";    // "mean" or "worst" over the records
   std::string metric = "x_r";        // "x_r" or "E_r"
   int threads = 0;
+  const std::atomic<bool>* stop = nullptr;  // set (Ctrl-C): the search ends with DesignInterrupted
 };
 
 // Shorthands for --optimize: beta, eps, mass_ratio; anything with a dot is a
 // scene key. Fills key and the default range; false if unknown.
 bool design_parameter(const std::string& name, DesignOptions* opt);
 
-// Runs the search; returns {best: {value, objective}, evaluations: [...]}.
-nlohmann::json optimize_design(const DesignOptions& opt);
+// One value tried: its objective, and in which phase ("grid", "refine").
+struct DesignEvaluation {
+  double value = 0, objective = 0;
+  std::string phase;
+};
+
+// design.json: the search, the best value found and every evaluation.
+struct DesignResult {
+  DesignOptions options;
+  double best_value = 0, best_objective = 0;
+  std::vector<DesignEvaluation> evaluations;
+  nlohmann::json to_json() const;
+};
+
+// The search was stopped (DesignOptions::stop): it has no result.
+class DesignInterrupted : public std::runtime_error {
+ public:
+  DesignInterrupted() : std::runtime_error("design: interrupted") {}
+};
+
+// Runs the search (the runs of each step through the sweep's parallel map).
+DesignResult optimize_design(const DesignOptions& opt);
 
 }  // namespace vines::host

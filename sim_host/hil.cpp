@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "sim_host/build_engine.hpp"
 #include "sim_host/hil_child.hpp"
 #include "sim_host/hil_faults.hpp"
 #include "sim_host/hil_lab.hpp"
@@ -37,11 +38,7 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what) {
   if (cfg.mode == link::NodeMode::kHybrid) return {};
   const Scalar scalar = cfg.scalar ? Scalar::kFloat : Scalar::kDouble;
-  std::unique_ptr<Engine> eng = make_engine(cfg.scene, scalar);
-  if (!eng) throw std::runtime_error(what + ": " + missing_engine(cfg.scene, scalar));
-  const ParamError e = eng->build(cfg.scene);
-  if (!e.ok()) throw std::runtime_error(what + ": " + e.field + ": " + e.message);
-  return eng->model_image();
+  return build_engine(cfg.scene, scalar, what)->model_image();
 }
 
 // The board a "qemu:TARGET" node runs on: QEMU machine, scalar, and the

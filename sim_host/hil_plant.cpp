@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <string>
 
+#include "sim_host/build_engine.hpp"
+
 namespace vines::host {
 
 link::ModalData modal_data(const ModelInfo& info) {
@@ -38,12 +40,15 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
   SceneParams p = c.scene;
   if (mode_ == link::NodeMode::kHybrid) p.device.kind = DeviceKind::kNone;  // the device is on the table
   const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;
-  engine_ = make_engine(p, scalar);
-  if (!engine_) {
-    std::snprintf(msg, cap, "frame.stories: %s", missing_engine(p, scalar).c_str());
+  // Hybrid nodes build the bare frame here; the others load the bench's image.
+  const bool hybrid = mode_ == link::NodeMode::kHybrid;
+  try {
+    engine_ = hybrid ? build_engine(p, scalar, "node") : engine_for(p, scalar, "node");
+  } catch (const EngineError& e) {
+    std::snprintf(msg, cap, "%s", e.reason().c_str());
     return false;
   }
-  if (mode_ != link::NodeMode::kHybrid) {
+  if (!hybrid) {
     if (image_.empty()) {
       std::snprintf(msg, cap, "no model image: send it before the settings");
       return false;
@@ -55,12 +60,6 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     }
     n_ = p.frame.stories;
     return true;
-  }
-  const ParamError e = engine_->build(p);
-  if (!e.ok()) {
-    if (e.index >= 0) std::snprintf(msg, cap, "%s[%d]: %s", e.field, e.index, e.message);
-    else std::snprintf(msg, cap, "%s: %s", e.field, e.message);
-    return false;
   }
   n_ = p.frame.stories;
   hybrid_.setup(modal_data(engine_->info()), 1.0 / p.loop.sensor_rate_hz);

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "sim_host/build_engine.hpp"
+#include "sim_host/csv.hpp"
 #include "sim_host/names.hpp"
 
 namespace vines::host {
@@ -26,15 +28,7 @@ struct Trace {
 };
 
 Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
-  std::unique_ptr<Engine> eng = make_engine(p, scene.scalar);
-  if (!eng)
-    throw std::runtime_error(scene.path + ": frame.stories: " + missing_engine(p, scene.scalar));
-  const ParamError e = eng->build(p);
-  if (!e.ok()) {
-    std::string key = e.field;
-    if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
-    throw std::runtime_error(scene.path + ": " + key + ": " + e.message);
-  }
+  std::unique_ptr<Engine> eng = build_engine(p, scene.scalar, scene.path);
   Trace tr;
   tr.info = eng->info();
   const auto t0 = std::chrono::steady_clock::now();
@@ -65,9 +59,7 @@ json modal_json(const ModelInfo& in) {
           {"total_mass_kg", in.total_mass}};
 }
 
-json response_json(const Trace& tr) {
-  const int n = tr.info.stories;
-  const RunTotals& t = tr.totals;
+json response_json(const RunTotals& t, int n) {
   return {{"peak_displacement_m", head(t.peak_x, n)},
           {"peak_drift_m", head(t.peak_drift, n)},
           {"peak_top_displacement_m", t.peak_top},
@@ -76,48 +68,56 @@ json response_json(const Trace& tr) {
           {"strain_energy_positive_increments", t.strain_increments}};
 }
 
+// The device's design as the model built it.
+json device_json(DeviceKind kind, const ModelInfo& info) {
+  json dp = {{"floor", info.device_floor}};
+  if (kind == DeviceKind::kTmd) {
+    const TmdDesign& d = info.tmd;
+    dp.update({{"mass_kg", d.mass}, {"k_n_per_m", d.k}, {"c_ns_per_m", d.c}, {"mu", d.mu},
+               {"lambda", d.lambda}, {"xi", d.xi}, {"frequency_hz", d.omega / (2 * M_PI)}});
+  }
+  if (kind == DeviceKind::kVines) {
+    const VinesDesign& d = info.vines;
+    dp.update({{"mass_kg", d.mass}, {"R_m", d.radius}, {"b_m", d.box_length}, {"gap_m", d.gap},
+               {"beta", d.box_length / (2 * d.radius)}, {"hertz_C", d.c}, {"eps", d.eps},
+               {"tau_s", d.tau}, {"v_ref_mps", d.v_ref}, {"reduced_mass_kg", d.m_star}});
+  }
+  return dp;
+}
+
 void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
-  std::ofstream out(file);
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  CsvWriter csv(file.string());
   const int n = dev.info.stories;
   const DeviceKind kind = scene.params.device.kind;
-  out << "t_s,ag_mps2";
+  // Header: time, ground, per-floor quantities, E_e, the device's state, the bare frame's.
+  csv.raw("t_s").raw("ag_mps2");
   for (const char* q : {"x", "v", "acc", "drift"})
     for (int i = 1; i <= n; ++i)
-      out << ',' << q << i << (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2");
-  out << ",Ee_Js";
+      csv.raw(q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2"));
+  csv.raw("Ee_Js");
   if (kind == DeviceKind::kVines)
-    out << ",particle_x_m,particle_v_mps,wall_left_m,wall_right_m,contact_force_n,contact_mode";
-  if (kind == DeviceKind::kTmd) out << ",tmd_x_m,tmd_v_mps";
-  if (bare) out << ",bare_x_top_m,bare_Ee_Js";
-  out << '\n';
-  char buf[64];
-  auto put = [&](double v) {
-    std::snprintf(buf, sizeof buf, ",%.9g", v);
-    out << buf;
-  };
+    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n", "contact_mode"})
+      csv.raw(h);
+  if (kind == DeviceKind::kTmd) csv.raw("tmd_x_m").raw("tmd_v_mps");
+  if (bare) csv.raw("bare_x_top_m").raw("bare_Ee_Js");
+  csv.end_row();
+  // One row per snapshot: time to the microsecond, the rest to 9 digits.
+  constexpr const char* kValue = "%.9g";
   for (std::size_t r = 0; r < dev.rows.size(); ++r) {
     const Snapshot& s = dev.rows[r];
-    std::snprintf(buf, sizeof buf, "%.6f", s.t);
-    out << buf;
-    put(s.ag);
+    csv.number(s.t, "%.6f").number(s.ag, kValue);
     for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift})
-      for (int i = 0; i < n; ++i) put((*a)[i]);
-    put(s.elastic_energy);
+      for (int i = 0; i < n; ++i) csv.number((*a)[i], kValue);
+    csv.number(s.elastic_energy, kValue);
     if (kind == DeviceKind::kVines) {
-      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) put(v);
-      out << ',' << s.mode;
+      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) csv.number(v, kValue);
+      csv.integer(s.mode);
     }
-    if (kind == DeviceKind::kTmd) {
-      put(s.tmd_x);
-      put(s.tmd_v);
-    }
-    if (bare) {
-      put(bare->rows[r].x[n - 1]);
-      put(bare->rows[r].elastic_energy);
-    }
-    out << '\n';
+    if (kind == DeviceKind::kTmd) csv.number(s.tmd_x, kValue).number(s.tmd_v, kValue);
+    if (bare) csv.number(bare->rows[r].x[n - 1], kValue).number(bare->rows[r].elastic_energy, kValue);
+    csv.end_row();
   }
+  csv.close();
 }
 
 }  // namespace
@@ -153,13 +153,14 @@ Excitation load_excitation(const Scene& scene, const std::string& record_overrid
   return ex;
 }
 
-json run_scene(const Scene& scene, const RunOptions& opt) {
+RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   const Excitation ex = load_excitation(scene, opt.record_override);
   const SceneParams& p = scene.params;
   const bool has_device = p.device.kind != DeviceKind::kNone;
   const bool series = !opt.out_dir.empty() && scene.output.timeseries;
   const int every = series ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz)) : 0;
 
+  // The device run, and with a device the bare frame on the same samples.
   const Trace dev = run_engine(scene, p, ex, every);
   Trace bare;
   if (has_device) {
@@ -167,29 +168,54 @@ json run_scene(const Scene& scene, const RunOptions& opt) {
     pb.device.kind = DeviceKind::kNone;
     bare = run_engine(scene, pb, ex, every);
   }
+  RunReport r;
+  r.scene = scene.name;
+  r.scene_file = scene.path;
+  r.params = p;
+  r.scalar = scene.scalar;
+  r.record = {ex.record.path, ex.record.dt_s, ex.record.accel_mps2.size(), ex.record.pga_mps2(),
+              static_cast<double>(ex.samples.size() - 1) / ex.rate_hz};
+  r.info = dev.info;
+  r.totals = dev.totals;
+  if (has_device) r.bare = bare.totals;
+  r.wall_s = dev.wall_s;
 
-  const RunTotals& t = dev.totals;
+  if (!opt.out_dir.empty()) {
+    const fs::path dir(opt.out_dir);
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw std::runtime_error(opt.out_dir + ": cannot create: " + ec.message());
+    std::ofstream out(dir / "summary.json");
+    out << r.to_json().dump(2) << '\n';
+    if (!out) throw std::runtime_error((dir / "summary.json").string() + ": cannot write");
+    if (series) write_timeseries(dir / "timeseries.csv", scene, dev, has_device ? &bare : nullptr);
+  }
+  return r;
+}
+
+json RunReport::to_json() const {
+  const SceneParams& p = params;
+  const RunTotals& t = totals;
   json j;
-  j["scene"] = scene.name;
-  j["scene_file"] = scene.path;
+  j["scene"] = scene;
+  j["scene_file"] = scene_file;
   j["device"] = device_name(p.device.kind);
   if (p.device.kind == DeviceKind::kVines) j["contact_law"] = law_name(p.device.vines.law);
-  j["stories"] = dev.info.stories;
-  j["scalar"] = scalar_name(scene.scalar);
+  j["stories"] = info.stories;
+  j["scalar"] = scalar_name(scalar);
   j["sensor_rate_hz"] = p.loop.sensor_rate_hz;
-  j["record"] = {{"path", ex.record.path},
-                 {"dt_s", ex.record.dt_s},
-                 {"points", ex.record.accel_mps2.size()},
-                 {"pga_mps2", ex.record.pga_mps2()},
-                 {"simulated_s", static_cast<double>(ex.samples.size() - 1) / ex.rate_hz}};
-  j.update(response_json(dev));
-  if (has_device) {
-    const RunTotals& b = bare.totals;
-    j["x_r"] = (b.peak_top - t.peak_top) / b.peak_top;
-    j["E_r"] = (b.elastic_energy - t.elastic_energy) / b.elastic_energy;
-    j["E_r_positive_increments"] =
-        (b.strain_increments - t.strain_increments) / b.strain_increments;
-    j["bare"] = response_json(bare);
+  j["record"] = {{"path", record.path},
+                 {"dt_s", record.dt_s},
+                 {"points", record.points},
+                 {"pga_mps2", record.pga_mps2},
+                 {"simulated_s", record.simulated_s}};
+  j.update(response_json(t, info.stories));
+  if (bare) {
+    const RunTotals& b = *bare;
+    j["x_r"] = x_r();
+    j["E_r"] = E_r();
+    j["E_r_positive_increments"] = reduction(b.strain_increments, t.strain_increments);
+    j["bare"] = response_json(b, info.stories);
   }
   j["contacts"] = t.count.contacts;
   if (p.device.kind == DeviceKind::kVines) j["max_overlap_m"] = t.max_overlap;
@@ -213,30 +239,9 @@ json run_scene(const Scene& scene, const RunOptions& opt) {
                    {"max_events_in_a_step", t.count.max_events_in_step},
                    {"bad_samples_held", t.count.bad_samples},
                    {"divergences_rolled_back", t.count.divergences}};
-  j["modal"] = modal_json(dev.info);
-  json dp = {{"floor", dev.info.device_floor}};
-  if (p.device.kind == DeviceKind::kTmd) {
-    const TmdDesign& d = dev.info.tmd;
-    dp.update({{"mass_kg", d.mass}, {"k_n_per_m", d.k}, {"c_ns_per_m", d.c}, {"mu", d.mu},
-               {"lambda", d.lambda}, {"xi", d.xi}, {"frequency_hz", d.omega / (2 * M_PI)}});
-  }
-  if (p.device.kind == DeviceKind::kVines) {
-    const VinesDesign& d = dev.info.vines;
-    dp.update({{"mass_kg", d.mass}, {"R_m", d.radius}, {"b_m", d.box_length}, {"gap_m", d.gap},
-               {"beta", d.box_length / (2 * d.radius)}, {"hertz_C", d.c}, {"eps", d.eps},
-               {"tau_s", d.tau}, {"v_ref_mps", d.v_ref}, {"reduced_mass_kg", d.m_star}});
-  }
-  if (has_device) j["device_params"] = dp;
-  j["wall_time_s"] = dev.wall_s;
-
-  if (!opt.out_dir.empty()) {
-    const fs::path dir(opt.out_dir);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw std::runtime_error(opt.out_dir + ": cannot create: " + ec.message());
-    std::ofstream(dir / "summary.json") << j.dump(2) << '\n';
-    if (series) write_timeseries(dir / "timeseries.csv", scene, dev, has_device ? &bare : nullptr);
-  }
+  j["modal"] = modal_json(info);
+  if (bare) j["device_params"] = device_json(p.device.kind, info);
+  j["wall_time_s"] = wall_s;
   return j;
 }
 

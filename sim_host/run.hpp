@@ -2,6 +2,8 @@
 // scene has a device; writes DIR/summary.json and DIR/timeseries.csv.
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,11 +27,40 @@ struct Excitation {
   double rate_hz = 0;
 };
 
+// How much a device reduces a figure of the bare frame: x_r from the peak top
+// displacements, E_r from the elastic energy integrals (docs/model.md).
+inline double reduction(double bare, double with_device) { return (bare - with_device) / bare; }
+
 Excitation load_excitation(const Scene& scene, const std::string& record_override);
 
+// The record a run read, as loaded and scaled.
+struct RecordSummary {
+  std::string path;
+  double dt_s = 0;
+  std::size_t points = 0;
+  double pga_mps2 = 0;
+  double simulated_s = 0;  // the samples run, at the sensor rate
+};
+
+// What `vines run` reports (summary.json is to_json()).
+struct RunReport {
+  std::string scene, scene_file;
+  SceneParams params;
+  Scalar scalar = Scalar::kDouble;
+  RecordSummary record;
+  ModelInfo info;                 // the model of the device run
+  RunTotals totals;               // the device run
+  std::optional<RunTotals> bare;  // with a device: the bare frame on the same record
+  double wall_s = 0;              // the device run's loop
+  double x_r() const { return reduction(bare->peak_top, totals.peak_top); }
+  double E_r() const { return reduction(bare->elastic_energy, totals.elastic_energy); }
+  nlohmann::json to_json() const;
+};
+
 // Runs the scene's device (and the bare frame if there is a device), returns
-// the summary (also written to out_dir when given). Throws std::runtime_error
-// with a message naming the input on any user error.
-nlohmann::json run_scene(const Scene& scene, const RunOptions& opt);
+// the report (summary.json and timeseries.csv are written to out_dir when
+// given). Throws std::runtime_error with a message naming the input on any
+// user error.
+RunReport run_scene(const Scene& scene, const RunOptions& opt);
 
 }  // namespace vines::host

@@ -4,15 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <map>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
-#include <unistd.h>
 
-#include "sim_host/engine.hpp"
+#include "sim_host/build_engine.hpp"
+#include "sim_host/parallel.hpp"
 
 namespace vines::host {
 namespace {
@@ -105,12 +102,12 @@ int count_nonfinite(const Pass& p, int n) {
 
 // The engine of a case's parameters, built; nullptr and the reason if refused.
 std::unique_ptr<Engine> build(const SceneParams& p, Scalar scalar, std::string* refusal) {
-  std::unique_ptr<Engine> eng = make_engine(p, scalar);
-  if (!eng) throw std::logic_error(missing_engine(p, scalar));  // the draw picks compiled frames only
-  const ParamError e = eng->build(p);
-  if (e.ok()) return eng;
-  *refusal = std::string(e.field) + (e.index >= 0 ? "[" + std::to_string(e.index) + "]" : "") + ": " + e.message;
-  return nullptr;
+  try {
+    return build_engine(p, scalar, "stress case");
+  } catch (const EngineError& e) {
+    *refusal = e.reason();
+    return nullptr;
+  }
 }
 
 // ---- bounds (measured over seeds 1-3, 6000 cases; see the README) ----
@@ -258,31 +255,13 @@ StressRun run_stress(const StressOptions& opt, const std::vector<StressRecord>& 
   const auto n = static_cast<std::size_t>(opt.count);
   run.cases.resize(n);
   run.results.resize(n);
-  std::atomic<std::size_t> next{0}, finished{0};
-  std::mutex print_mutex;
-  const bool tty = opt.progress && isatty(fileno(stderr));
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t every = std::max<std::size_t>(1, n / (tty ? 200 : 10));
-  auto worker = [&] {
-    for (;;) {
-      if (stop && stop->load()) return;
-      const std::size_t k = next.fetch_add(1);
-      if (k >= n) return;
-      run.cases[k] = draw_case(opt.seed, static_cast<std::int64_t>(k), records, opt.limits);
-      run.results[k] = run_case(run.cases[k], records);
-      const std::size_t done = ++finished;
-      if (!opt.progress || (done % every != 0 && done != n)) continue;
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::lock_guard<std::mutex> lock(print_mutex);
-      std::fprintf(stderr, tty ? "\rstress: %zu/%zu cases, %.1f s " : "stress: %zu/%zu cases, %.1f s\n", done, n, el);
-      if (tty && done == n) std::fputc('\n', stderr);
-    }
-  };
-  const int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  // Case k is drawn from (seed, k) alone and stored at k.
+  const MapOptions map{opt.threads, stop, opt.progress, "stress", "cases"};
+  parallel_map(n, map, [&](std::size_t k) {
+    run.cases[k] = draw_case(opt.seed, static_cast<std::int64_t>(k), records, opt.limits);
+    run.results[k] = run_case(run.cases[k], records);
+  });
   run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
 }
@@ -299,52 +278,67 @@ json case_report(const StressCase& c, const StressResult& r, const std::vector<S
   return j;
 }
 
-json stress_summary(const StressOptions& opt, const StressRun& run, const std::vector<StressRecord>& records,
-                    int worst) {
-  std::size_t done = 0, refused = 0, failed = 0;
-  std::int64_t steps = 0;
-  std::map<std::string, std::pair<std::size_t, std::int64_t>> refusals;  // reason -> count, first case
+StressSummary stress_summary(const StressOptions& opt, const StressRun& run, int worst) {
+  StressSummary s;
+  s.seed = opt.seed;
+  s.requested = opt.count;
+  s.max_steps_per_run = opt.limits.max_steps;
+  s.wall_s = run.wall_s;
+  // Totals, and refusals by reason (in order of reason).
+  std::map<std::string, RefusalSummary> refusals;
   for (std::size_t i = 0; i < run.results.size(); ++i) {
     const StressResult& r = run.results[i];
     if (!r.done) continue;
-    ++done;
-    steps += r.steps;
-    failed += !r.ok();
+    ++s.cases;
+    s.steps += r.steps;
+    s.failed += !r.ok();
     if (r.refusal.empty()) continue;
-    ++refused;
-    auto& e = refusals.try_emplace(r.refusal, 0, static_cast<std::int64_t>(i)).first->second;
-    ++e.first;
+    ++s.refused;
+    ++refusals.try_emplace(r.refusal, RefusalSummary{r.refusal, 0, static_cast<std::int64_t>(i)}).first->second.cases;
   }
-  json checks = json::object();
+  for (auto& [reason, r] : refusals) s.refusals.push_back(r);
+  s.passed = s.failed == 0 && s.cases == run.results.size();
   for (int c = 0; c < kCheckCount; ++c) {
+    CheckSummary& sum = s.checks[static_cast<std::size_t>(c)];
     std::vector<std::size_t> idx;
-    std::size_t fails = 0;
     for (std::size_t i = 0; i < run.results.size(); ++i) {
       const CheckResult& k = run.results[i].checks[static_cast<std::size_t>(c)];
       if (!k.applies) continue;
       idx.push_back(i);
-      fails += !k.ok();
+      sum.failed += !k.ok();
     }
+    sum.runs = idx.size();
     // Worst first (cases at zero are not listed); ties by case index, so the
     // table does not depend on threads.
     auto ratio = [&](std::size_t i) { return run.results[i].checks[static_cast<std::size_t>(c)].ratio(); };
     std::stable_sort(idx.begin(), idx.end(), [&](std::size_t x, std::size_t y) { return ratio(x) > ratio(y); });
-    json list = json::array();
     for (std::size_t w = 0; w < idx.size() && static_cast<int>(w) < worst; ++w) {
       const CheckResult& k = run.results[idx[w]].checks[static_cast<std::size_t>(c)];
       if (k.value == 0) break;
-      list.push_back({{"value", k.value}, {"bound", k.bound}, {"ok", k.ok()},
-                      {"scene", case_json(run.cases[idx[w]], records)}});
+      sum.worst.push_back({idx[w], k.value, k.bound, k.ok(), ""});
     }
-    checks[check_name(c)] = {{"runs", idx.size()}, {"failed", fails}, {"worst", list}};
+  }
+  return s;
+}
+
+json StressSummary::to_json(const StressRun& run, const std::vector<StressRecord>& records) const {
+  json jc = json::object();
+  for (int c = 0; c < kCheckCount; ++c) {
+    const CheckSummary& sum = checks[static_cast<std::size_t>(c)];
+    json list = json::array();
+    for (const WorstCase& w : sum.worst) {
+      json jw = {{"value", w.value}, {"bound", w.bound}, {"ok", w.ok}, {"scene", case_json(run.cases[w.index], records)}};
+      if (!w.scene_file.empty()) jw["scene_file"] = w.scene_file;
+      list.push_back(jw);
+    }
+    jc[check_name(c)] = {{"runs", sum.runs}, {"failed", sum.failed}, {"worst", list}};
   }
   json ref = json::array();
-  for (const auto& [reason, e] : refusals) ref.push_back({{"reason", reason}, {"cases", e.first}, {"first_case", e.second}});
-  return {{"seed", opt.seed},       {"cases", done},        {"requested", opt.count}, {"refused", refused},
-          {"failed", failed},       {"passed", failed == 0 && done == run.results.size()},
-          {"steps", steps},         {"max_steps_per_run", opt.limits.max_steps},
-          {"wall_time_s", run.wall_s}, {"cases_per_s", run.wall_s > 0 ? done / run.wall_s : 0.0},
-          {"refusals", ref},        {"checks", checks}};
+  for (const RefusalSummary& r : refusals)
+    ref.push_back({{"reason", r.reason}, {"cases", r.cases}, {"first_case", r.first_case}});
+  return {{"seed", seed},       {"cases", cases},        {"requested", requested}, {"refused", refused},
+          {"failed", failed},   {"passed", passed},      {"steps", steps},         {"max_steps_per_run", max_steps_per_run},
+          {"wall_time_s", wall_s}, {"cases_per_s", cases_per_s()}, {"refusals", ref}, {"checks", jc}};
 }
 
 }  // namespace vines::host

@@ -119,10 +119,45 @@ struct StressRun {
 StressRun run_stress(const StressOptions& opt, const std::vector<StressRecord>& records,
                      const std::atomic<bool>* stop);
 
-// Summary: per check how many ran and failed and the worst cases; refusals by
-// reason; totals.
-nlohmann::json stress_summary(const StressOptions& opt, const StressRun& run,
-                              const std::vector<StressRecord>& records, int worst);
+// A case listed among the worst of a check.
+struct WorstCase {
+  std::size_t index = 0;  // into the run's cases
+  double value = 0, bound = 0;
+  bool ok = true;
+  std::string scene_file;  // written as a scene (--out), else ""
+};
+
+// One check over the run: how many cases it applied to, failed, the worst.
+struct CheckSummary {
+  std::size_t runs = 0, failed = 0;
+  std::vector<WorstCase> worst;  // worst first, cases at zero left out
+};
+
+// Cases refused at scene load for one reason.
+struct RefusalSummary {
+  std::string reason;
+  std::size_t cases = 0;
+  std::int64_t first_case = 0;
+};
+
+struct StressSummary {
+  std::uint64_t seed = 0;
+  std::int64_t requested = 0;
+  std::size_t cases = 0, refused = 0, failed = 0;  // cases: run (all unless interrupted)
+  bool passed = false;
+  std::int64_t steps = 0;
+  int max_steps_per_run = 0;
+  double wall_s = 0;
+  std::vector<RefusalSummary> refusals;  // by reason
+  std::array<CheckSummary, kCheckCount> checks;
+  double cases_per_s() const { return wall_s > 0 ? cases / wall_s : 0.0; }
+  // stress.json; the worst cases' scenes from the run.
+  nlohmann::json to_json(const StressRun& run, const std::vector<StressRecord>& records) const;
+};
+
+// Summary: per check how many ran and failed and the `worst` worst cases;
+// refusals by reason; totals.
+StressSummary stress_summary(const StressOptions& opt, const StressRun& run, int worst);
 
 // One case in full: its scene and every check.
 nlohmann::json case_report(const StressCase& c, const StressResult& r,

@@ -1,5 +1,7 @@
 // Random scenes for `vines stress`: the records, the draw of one case from
 // (seed, index), its ground-motion window, and the case as a scene file.
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -254,6 +256,7 @@ std::string write_case_scene(const StressCase& c, const std::vector<StressRecord
                              const std::string& dir) {
   const SceneParams& p = c.params;
   const FrameParams& f = p.frame;
+  const double dt = records[static_cast<std::size_t>(c.record)].record.dt_s;
   const std::string stem = "case_" + std::to_string(c.index);
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -265,33 +268,43 @@ std::string write_case_scene(const StressCase& c, const std::vector<StressRecord
     for (int i = 0; i < c.window_samples; ++i) rec << num(r.accel_mps2[c.first_sample + i] * c.pga_scale) << '\n';
     if (!rec) throw std::runtime_error(dir + "/" + stem + "_record.txt: cannot write");
   }
-  const fs::path path = fs::path(dir) / (stem + ".toml");
-  std::ofstream out(path);
-  auto list = [&](const double* v, int n) {
-    std::string s = "[";
-    for (int i = 0; i < n; ++i) s += (i ? ", " : "") + num(v[i]);
-    return s + "]";
+  // The scene as a toml++ table (doubles print in full: the same numbers back).
+  auto list = [](const auto* v, int n) {
+    toml::array a;
+    for (int i = 0; i < n; ++i) a.push_back(v[i]);
+    return a;
   };
-  out << "# vines stress --seed " << c.seed << " --case " << c.index << "\n# " << case_json(c, records).dump()
-      << "\n[scene]\nname = \"stress_" << c.seed << "_" << c.index << "\"\n\n[frame]\npreset = \"custom\"\n"
-      << "masses_kg = " << list(f.mass_kg, f.stories) << "\nstiffnesses_n_per_m = "
-      << list(f.stiffness_n_per_m, f.stories) << "\ndamping = \"" << damping_name(f.damping) << "\"\n"
-      << "stiffness_damping_s = " << num(f.stiffness_damping_s) << "\nmodal_zeta = " << num(f.modal_zeta) << '\n';
-  if (f.stories > 1)
-    out << "rayleigh_zeta = " << list(f.rayleigh_zeta, 2) << "\nrayleigh_modes = [" << f.rayleigh_modes[0]
-        << ", " << f.rayleigh_modes[1] << "]\n";
+  toml::table frame{{"preset", "custom"},
+                    {"masses_kg", list(f.mass_kg, f.stories)},
+                    {"stiffnesses_n_per_m", list(f.stiffness_n_per_m, f.stories)},
+                    {"damping", damping_name(f.damping)},
+                    {"stiffness_damping_s", f.stiffness_damping_s},
+                    {"modal_zeta", f.modal_zeta}};
+  if (f.stories > 1) {
+    frame.insert("rayleigh_zeta", list(f.rayleigh_zeta, 2));
+    frame.insert("rayleigh_modes", list(f.rayleigh_modes, 2));
+  }
+  toml::table scene{
+      {"scene", toml::table{{"name", "stress_" + std::to_string(c.seed) + "_" + std::to_string(c.index)}}},
+      {"frame", frame},
+      {"record", toml::table{{"path", stem + "_record.txt"}, {"format", "accel"}, {"units", "m/s2"}, {"dt_s", dt}}},
+      {"loop", toml::table{{"sensor_rate_hz", p.loop.sensor_rate_hz},
+                           {"divergence_limit_m", p.loop.divergence_limit_m},
+                           {"energy_ledger", true},
+                           {"scalar", scalar_name(c.scalar)}}},
+      {"output", toml::table{{"rate_hz", p.loop.sensor_rate_hz}}}};
   if (p.device.kind == DeviceKind::kVines) {
     const VinesParams& v = p.device.vines;
-    out << "\n[device]\nkind = \"vines\"\nfloor = " << p.device.floor << "\nmass_ratio = " << num(p.device.mass_ratio)
-        << "\n\n[vines]\nlaw = \"" << law_name(v.law) << "\"\nbeta = " << num(v.beta) << "\neps = " << num(v.eps)
-        << "\ninitial_velocity_mps = " << num(v.initial_velocity_mps) << '\n';
-    if (!v.start_at_left_wall) out << "initial_position_m = " << num(v.initial_position_m) << '\n';
+    scene.insert("device", toml::table{{"kind", "vines"}, {"floor", p.device.floor}, {"mass_ratio", p.device.mass_ratio}});
+    toml::table vines{{"law", law_name(v.law)}, {"beta", v.beta}, {"eps", v.eps},
+                      {"initial_velocity_mps", v.initial_velocity_mps}};
+    if (!v.start_at_left_wall) vines.insert("initial_position_m", v.initial_position_m);
+    scene.insert("vines", vines);
   }
-  out << "\n[record]\npath = \"" << stem << "_record.txt\"\nformat = \"accel\"\nunits = \"m/s2\"\ndt_s = "
-      << num(records[static_cast<std::size_t>(c.record)].record.dt_s) << "\n\n[loop]\nsensor_rate_hz = "
-      << num(p.loop.sensor_rate_hz) << "\ndivergence_limit_m = " << num(p.loop.divergence_limit_m) << "\nenergy_ledger = true"
-      << "\nscalar = \"" << scalar_name(c.scalar) << "\"\n\n[output]\nrate_hz = " << num(p.loop.sensor_rate_hz)
-      << '\n';
+  const fs::path path = fs::path(dir) / (stem + ".toml");
+  std::ofstream out(path);
+  out << "# vines stress --seed " << c.seed << " --case " << c.index << "\n# " << case_json(c, records).dump()
+      << "\n" << scene << '\n';
   if (!out) throw std::runtime_error(path.string() + ": cannot write");
   return path.string();
 }

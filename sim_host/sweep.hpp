@@ -19,6 +19,8 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,14 +77,46 @@ SweepSpec load_sweep(const std::string& path);
 std::vector<RunPlan> plan_runs(const SweepSpec& spec);
 
 // Runs plan[i] for every i with i % stride == offset (others stay not done),
-// on `threads` threads; stops taking new runs once *stop is set.
+// on `threads` threads (parallel_map); stops taking new runs once *stop is set.
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
                                int offset, int stride, const std::atomic<bool>* stop,
                                bool progress);
 
-// results.csv and summary.json of a (possibly partial) result set; returns the summary.
-nlohmann::json write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
-                           const std::vector<RunResult>& results, const std::string& out_dir,
-                           double wall_s);
+// Mean, sample standard deviation, range and count of some x_r or E_r.
+struct Stats {
+  double mean = 0, sd = 0, min = 0, max = 0;
+  std::size_t n = 0;
+};
+
+// The runs of a study with one value of its group key.
+struct GroupSummary {
+  double value = 0;
+  Stats x_r, E_r;
+};
+
+struct StudySummary {
+  std::string name, scene, device;
+  std::size_t runs = 0;                 // finished without error
+  std::optional<Stats> x_r, E_r;        // none when no run finished
+  std::string group_by;                 // the group key ("": no groups)
+  std::vector<GroupSummary> groups;     // by value
+  std::string optimize;                 // "", "x_r" or "E_r"
+  double best_value = 0, best = 0;      // the group of the best mean (with optimize)
+};
+
+// summary.json of a sweep.
+struct SweepSummary {
+  std::string spec;
+  std::size_t runs = 0, done = 0, failed = 0;
+  double wall_s = 0;
+  std::vector<StudySummary> studies;
+  double runs_per_s() const { return wall_s > 0 ? done / wall_s : 0.0; }
+  nlohmann::json to_json() const;
+};
+
+// results.csv and summary.json of a (possibly partial) result set in
+// out_dir; returns the summary.
+SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
+                         const std::vector<RunResult>& results, const std::string& out_dir, double wall_s);
 
 }  // namespace vines::host

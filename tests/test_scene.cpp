@@ -11,6 +11,7 @@
 
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
+#include "sim_host/scene_toml.hpp"
 
 namespace {
 
@@ -446,6 +447,27 @@ TEST(RecordOverride, FormatComesFromTheFile) {
   const vines::host::Excitation cols = vines::host::load_excitation(at2, gm + "/" + kElCentro);
   EXPECT_EQ(cols.record.accel_mps2.size(), 2688u);
   EXPECT_DOUBLE_EQ(cols.record.dt_s, 0.02);
+}
+
+// A scene edited as a toml++ table (study overrides) is checked like a file:
+// the key set takes effect, a bad value is refused naming the key, and the
+// keys that came from the file keep their line.
+TEST(SceneTable, EditedTableIsCheckedLikeAFile) {
+  toml::table t = vines::host::read_scene_table(kScenes + "elcentro_vines.toml");
+  t["vines"].as_table()->insert_or_assign("beta", 1.5);
+  const Scene s = vines::host::scene_from_table(t, "edited.toml");
+  EXPECT_EQ(s.params.device.vines.beta, 1.5);
+  EXPECT_EQ(s.path, "edited.toml");
+  t["vines"].as_table()->insert_or_assign("beta", 0.5);
+  try {
+    vines::host::scene_from_table(t, "edited.toml");
+    FAIL() << "accepted beta = 0.5";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("edited.toml: vines.beta: "), std::string::npos) << e.what();
+  }
+  t["vines"].as_table()->insert_or_assign("law", "nope");
+  t["vines"].as_table()->insert_or_assign("beta", 1.5);
+  EXPECT_THROW(vines::host::scene_from_table(t, "edited.toml"), SceneError);
 }
 
 }  // namespace

@@ -2,13 +2,20 @@
 // against its published figures, and the sweep machinery itself.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "sim_host/csv.hpp"
 #include "sim_host/design.hpp"
+#include "sim_host/parallel.hpp"
 #include "sim_host/sweep.hpp"
 
 namespace {
@@ -104,14 +111,14 @@ TEST(Design, FindsTheClearanceOptimumByGridAndGoldenSection) {
   opt.scene_path = std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml";
   ASSERT_TRUE(design_parameter("beta", &opt));
   EXPECT_EQ(opt.key, "vines.beta");
-  const auto j = optimize_design(opt);
-  const double beta = j["best"]["value"], xr = j["best"]["objective"];
+  const DesignResult r = optimize_design(opt);
+  const double beta = r.best_value, xr = r.best_objective;
   EXPECT_GE(beta, 1.30);
   EXPECT_LE(beta, 1.40);
   // Refinement never loses the grid's best.
   double grid_best = -1;
-  for (const auto& e : j["evaluations"])
-    if (e["phase"] == "grid") grid_best = std::max(grid_best, e["objective"].get<double>());
+  for (const DesignEvaluation& e : r.evaluations)
+    if (e.phase == "grid") grid_best = std::max(grid_best, e.objective);
   EXPECT_GE(xr, grid_best);
   EXPECT_GT(xr, 0.25);
 }
@@ -169,6 +176,41 @@ TEST(Sweep, BadSpecsAreRefusedWithTheirKey) {
   EXPECT_NE(res[0].error.find("vines.beta"), std::string::npos) << res[0].error;
   EXPECT_TRUE(res[1].error.empty());
   fs::remove_all(dir);
+}
+
+// ---- the shared pieces: CSV writer, parallel map ----
+
+TEST(Csv, QuotesWhatMustBeAndChecksWrites) {
+  const fs::path f = fs::temp_directory_path() / ("vines_csv_" + std::to_string(::getpid()) + ".csv");
+  CsvWriter csv(f.string());
+  csv.raw("a").text("b,c").text("say \"hi\"").quoted("plain").number(0.1, "%.3g").integer(-7).empty();
+  csv.end_row();
+  csv.close();
+  std::ifstream in(f);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "a,\"b,c\",\"say \"\"hi\"\"\",\"plain\",0.1,-7,");
+  fs::remove(f);
+  try {
+    CsvWriter bad("/nonexistent-dir/x.csv");
+    FAIL() << "opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/x.csv: cannot write"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ParallelMap, RunsEveryIndexOnceAndStopsWhenTold) {
+  std::vector<std::atomic<int>> seen(1000);
+  parallel_map(seen.size(), MapOptions{3, nullptr, false}, [&](std::size_t i) { ++seen[i]; });
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].load(), 1) << i;
+  // Stopped before it starts: nothing runs; an exception reaches the caller.
+  std::atomic<bool> stop{true};
+  std::atomic<int> ran{0};
+  parallel_map(100, MapOptions{2, &stop, false}, [&](std::size_t) { ++ran; });
+  EXPECT_EQ(ran.load(), 0);
+  EXPECT_THROW(parallel_map(10, MapOptions{2, nullptr, false},
+                            [](std::size_t i) { if (i == 5) throw std::runtime_error("job 5"); }),
+               std::runtime_error);
 }
 
 }  // namespace

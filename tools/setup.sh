@@ -16,6 +16,7 @@ packages=(
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
   libsundials-dev                                # CVODE baseline (vines reference, tests)
+  libtbb-dev                                     # the parallel map of sweep, design, stress
   clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
 )
 

@@ -1,14 +1,13 @@
 // `vines bench SCENE.toml...`: speed against accuracy, against data/reference.
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/bench.hpp"
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/csv.hpp"
 #include "sim_host/scene.hpp"
 #include "vines/params.hpp"
 
@@ -23,21 +22,20 @@ struct BenchArgs {
   const CLI::Option* baselines = nullptr;  // --baselines, given or not
 };
 
-// The lines as CSV: a header of the JSON keys, then one row per line.
+// The lines as CSV: a header of the JSON keys, then one row per line, each
+// value as JSON writes it (strings quoted, null for unknown errors).
 void write_csv(const std::string& path, const std::vector<host::BenchLine>& lines) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write");
-  bool header = true;
-  for (const host::BenchLine& l : lines) {
-    const nlohmann::json j = host::line_json(l);
-    if (header) {
-      for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.key();
-      out << '\n';
-      header = false;
+  host::CsvWriter csv(path);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const nlohmann::json j = host::line_json(lines[i]);
+    if (i == 0) {
+      for (auto it = j.begin(); it != j.end(); ++it) csv.text(it.key());
+      csv.end_row();
     }
-    for (auto it = j.begin(); it != j.end(); ++it) out << (it == j.begin() ? "" : ",") << it.value().dump();
-    out << '\n';
+    for (auto it = j.begin(); it != j.end(); ++it) csv.raw(it.value().dump());
+    csv.end_row();
   }
+  csv.close();
 }
 
 int bench(BenchArgs a) {

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -27,12 +28,22 @@ int design(DesignArgs a) {
     throw CLI::ValidationError("--optimize", a.name + ": unknown (a scene key needs --range)");
   const Scene scene = load_scene(opt.scene_path);
   if (a.out_dir.empty()) a.out_dir = "out/design_" + scene.name;
-  const nlohmann::json j = optimize_design(opt);
+  opt.stop = stop_on_interrupt();
+  DesignResult r;
+  try {
+    r = optimize_design(opt);
+  } catch (const DesignInterrupted&) {
+    std::fprintf(stderr, "vines design: interrupted; nothing written\n");
+    return kInterrupted;
+  }
   std::filesystem::create_directories(a.out_dir);
-  std::ofstream(std::filesystem::path(a.out_dir) / "design.json") << j.dump(2) << '\n';
+  const std::filesystem::path file = std::filesystem::path(a.out_dir) / "design.json";
+  std::ofstream out(file);
+  out << r.to_json().dump(2) << '\n';
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
   std::printf("design %s: best %s = %.6g, %s %s = %.2f %% (%zu evaluations; %s/design.json)\n", scene.name.c_str(),
-              opt.key.c_str(), j["best"]["value"].get<double>(), opt.objective.c_str(), opt.metric.c_str(),
-              100 * j["best"]["objective"].get<double>(), j["evaluations"].size(), a.out_dir.c_str());
+              opt.key.c_str(), r.best_value, opt.objective.c_str(), opt.metric.c_str(), 100 * r.best_objective,
+              r.evaluations.size(), a.out_dir.c_str());
   return kOk;
 }
 
@@ -44,7 +55,8 @@ void add_design(CLI::App& vines) {
   CLI::App* cmd = add_command(vines, "design",
                               "Best value of one design parameter for the scene's record or a set of records (mean "
                               "or worst case): coarse grid, then golden-section refinement.",
-                              "", [a] { return design(*a); });
+                              "Ctrl-C stops the search after the runs under way; nothing is written (exit status 130).",
+                              [a] { return design(*a); });
   cmd->add_option("SCENE.toml", opt.scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--optimize", a->name,
                   "beta (vines.beta, 1.05-2.0), eps (vines.eps, 0.1-1.0), mass_ratio (device.mass_ratio, "

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/engine.hpp"
+#include "sim_host/build_engine.hpp"
 #include "sim_host/names.hpp"
 #include "sim_host/scene.hpp"
 #include "vines/model_image.hpp"
@@ -28,15 +28,7 @@ int image(const ImageArgs& a) {
   const Scene scene = load_scene(a.scene_path);
   const Scalar scalar = a.scalar.empty() ? scene.scalar : a.scalar == "float" ? Scalar::kFloat : Scalar::kDouble;
   const vines::SceneParams& p = scene.params;
-  std::unique_ptr<Engine> eng = make_engine(p, scalar);
-  if (!eng) throw std::runtime_error(scene.path + ": frame.stories: " + missing_engine(p, scalar));
-  const vines::ParamError e = eng->build(p);
-  if (!e.ok()) {
-    std::string key = e.field;
-    if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
-    throw std::runtime_error(scene.path + ": " + key + ": " + e.message);
-  }
-  const std::vector<std::uint8_t> img = eng->model_image();
+  const std::vector<std::uint8_t> img = build_engine(p, scalar, scene.path)->model_image();
   vines::image::HeaderInfo h;
   if (!vines::image::read_header(img.data(), img.size(), &h)) throw std::runtime_error("no image written");
   // Checked writes: a short write or a failed close (disk full) is an error,

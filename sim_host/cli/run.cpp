@@ -4,6 +4,7 @@
 #include <string>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/names.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 
@@ -21,39 +22,38 @@ int run(RunArgs a) {
   RunOptions& opt = a.opt;
   const Scene scene = load_scene(a.scene_path);
   if (a.out->count() == 0) opt.out_dir = "out/" + scene.name;
-  const nlohmann::json j = run_scene(scene, opt);
+  const RunReport r = run_scene(scene, opt);
+  const vines::SceneParams& p = scene.params;
+  const Counters& k = r.totals.count;
   if (!opt.quiet) {
-    std::printf("scene %s: %s, %d stories, %s, %.0f Hz\n", scene.name.c_str(),
-                j["device"].get<std::string>().c_str(), j["stories"].get<int>(),
-                j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>());
-    std::printf("  peak top displacement %.6f m at t = %.3f s\n",
-                j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>());
-    if (j.contains("x_r"))
-      std::printf("  x_r = %.2f %%   E_r = %.2f %%   (bare peak %.6f m)\n", 100 * j["x_r"].get<double>(),
-                  100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
-    if (j["device"] == "vines")
+    std::printf("scene %s: %s, %d stories, %s, %.0f Hz\n", scene.name.c_str(), device_name(p.device.kind),
+                r.info.stories, scalar_name(r.scalar), p.loop.sensor_rate_hz);
+    std::printf("  peak top displacement %.6f m at t = %.3f s\n", r.totals.peak_top, r.totals.t_peak_top);
+    if (r.bare)
+      std::printf("  x_r = %.2f %%   E_r = %.2f %%   (bare peak %.6f m)\n", 100 * r.x_r(), 100 * r.E_r(),
+                  r.bare->peak_top);
+    if (p.device.kind == vines::DeviceKind::kVines)
       std::printf("  contacts %lld, deepest overlap %.3f mm, contact sub-steps %lld\n",
-                  j["contacts"].get<long long>(), 1e3 * j["max_overlap_m"].get<double>(),
-                  j["counters"]["contact_substeps"].get<long long>());
-    if (!j["energy_balance_residual"].is_null())
-      std::printf("  energy balance residual %.2e (relative)\n", j["energy_balance_residual"].get<double>());
-    std::printf("  loop wall time %.2f ms; results in %s/\n", 1e3 * j["wall_time_s"].get<double>(),
-                opt.out_dir.c_str());
+                  static_cast<long long>(k.contacts), 1e3 * r.totals.max_overlap,
+                  static_cast<long long>(k.contact_substeps));
+    if (p.loop.energy_ledger)
+      std::printf("  energy balance residual %.2e (relative)\n", r.totals.ledger.relative_residual());
+    std::printf("  loop wall time %.2f ms; results in %s/\n", 1e3 * r.wall_s, opt.out_dir.c_str());
   }
   // Limits the loop ran into are reported, never silent (even with --quiet).
-  const auto& k = j["counters"];
-  const vines::LoopParams& loop = scene.params.loop;
-  if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kAdaptive)
+  const vines::LoopParams& loop = p.loop;
+  const auto cap_hits = static_cast<long long>(k.cap_hits);
+  if (cap_hits > 0 && loop.contact_scheme == vines::ContactScheme::kAdaptive)
     std::fprintf(stderr, "vines run: warning: %lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): "
                  "contacts in them are not resolved\n",
-                 k["substep_cap_hits"].get<long long>(), loop.max_substeps_per_step);
-  if (k["substep_cap_hits"].get<long long>() > 0 && loop.contact_scheme == vines::ContactScheme::kBounded)
+                 cap_hits, loop.max_substeps_per_step);
+  if (cap_hits > 0 && loop.contact_scheme == vines::ContactScheme::kBounded)
     std::fprintf(stderr, "vines run: warning: in %lld steps the sub-step budget (loop.bounded_substeps = %d) "
                  "could not follow every event: they were deferred to the next step or stepped over\n",
-                 k["substep_cap_hits"].get<long long>(), loop.bounded_substeps);
-  if (k["divergences_rolled_back"].get<long long>() + k["bad_samples_held"].get<long long>() > 0)
+                 cap_hits, loop.bounded_substeps);
+  if (k.divergences + k.bad_samples > 0)
     std::fprintf(stderr, "vines run: warning: %lld diverging steps rolled back, %lld non-finite samples held\n",
-                 k["divergences_rolled_back"].get<long long>(), k["bad_samples_held"].get<long long>());
+                 static_cast<long long>(k.divergences), static_cast<long long>(k.bad_samples));
   return kOk;
 }
 

@@ -6,11 +6,13 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/names.hpp"
+#include "sim_host/parallel.hpp"
 #include "sim_host/stress.hpp"
 
 namespace vines::cli {
@@ -24,42 +26,55 @@ struct StressArgs {
   std::string out_dir;
 };
 
+// The checks in the order the tables list them: by name.
+std::vector<int> checks_by_name() {
+  std::vector<int> order;
+  for (int c = 0; c < host::kCheckCount; ++c) order.push_back(c);
+  std::sort(order.begin(), order.end(),
+            [](int x, int y) { return std::string(host::check_name(x)) < host::check_name(y); });
+  return order;
+}
+
+// A VI NES number of a worst-case line, at most `width` characters ("-" without one).
+std::string design_cell(bool vines, double v, std::size_t width) {
+  return vines ? std::to_string(v).substr(0, width) : "-";
+}
+
 // Tables of a stress summary: checks, worst cases, refusals.
-void print_stress(const nlohmann::json& s, int threads) {
+void print_stress(const host::StressSummary& s, const host::StressRun& run,
+                  const std::vector<host::StressRecord>& records, int threads) {
+  using namespace vines::host;
   std::printf("stress: %zu cases (seed %llu), %zu refused at load, %zu failed; %.1f s, %.0f cases/s, %d thread%s\n",
-              s["cases"].get<std::size_t>(), s["seed"].get<unsigned long long>(), s["refused"].get<std::size_t>(),
-              s["failed"].get<std::size_t>(), s["wall_time_s"].get<double>(), s["cases_per_s"].get<double>(), threads,
-              threads > 1 ? "s" : "");
+              s.cases, static_cast<unsigned long long>(s.seed), s.refused, s.failed, s.wall_s, s.cases_per_s(),
+              threads, threads > 1 ? "s" : "");
   std::printf("\n%-12s %6s %7s %12s %12s\n", "check", "runs", "failed", "worst", "bound");
-  for (const auto& [name, c] : s["checks"].items()) {
-    const auto& w = c["worst"];
-    std::printf("%-12s %6zu %7zu", name.c_str(), c["runs"].get<std::size_t>(), c["failed"].get<std::size_t>());
-    if (w.empty()) std::printf(" %12s", "0");
-    else std::printf(" %12.3g %12.3g", w[0]["value"].get<double>(), w[0]["bound"].get<double>());
+  for (int c : checks_by_name()) {
+    const CheckSummary& k = s.checks[static_cast<std::size_t>(c)];
+    std::printf("%-12s %6zu %7zu", check_name(c), k.runs, k.failed);
+    if (k.worst.empty()) std::printf(" %12s", "0");
+    else std::printf(" %12.3g %12.3g", k.worst[0].value, k.worst[0].bound);
     std::printf("\n");
   }
   std::printf("\nworst cases per check (re-run one with: vines stress --seed %llu --case K --json):\n",
-              s["seed"].get<unsigned long long>());
+              static_cast<unsigned long long>(s.seed));
   std::printf("%-12s %6s %10s %10s %3s %-11s %-6s %8s %7s %5s %5s %6s %-s\n", "check", "case", "value", "bound", "N",
               "device", "scalar", "rate_hz", "pga_x", "beta", "eps", "mu_%", "record");
-  for (const auto& [name, c] : s["checks"].items())
-    for (const auto& w : c["worst"]) {
-      const auto& sc = w["scene"];
-      const bool dev = sc["device"] != "none";
-      std::printf("%-12s %6lld %10.3g %10.3g %3d %-11s %-6s %8.1f %7.3f %5s %5s %6s %s%s\n", name.c_str(),
-                  sc["case"].get<long long>(), w["value"].get<double>(), w["bound"].get<double>(),
-                  sc["stories"].get<int>(), sc["device"].get<std::string>().c_str(),
-                  sc["scalar"].get<std::string>().c_str(), sc["sensor_rate_hz"].get<double>(),
-                  sc["pga_scale"].get<double>(), dev ? std::to_string(sc["beta"].get<double>()).substr(0, 5).c_str() : "-",
-                  dev ? std::to_string(sc["eps"].get<double>()).substr(0, 5).c_str() : "-",
-                  dev ? std::to_string(100 * sc["mass_ratio"].get<double>()).substr(0, 6).c_str() : "-",
-                  sc["record"].get<std::string>().c_str(), w["ok"].get<bool>() ? "" : "  FAIL");
+  for (int c : checks_by_name())
+    for (const WorstCase& w : s.checks[static_cast<std::size_t>(c)].worst) {
+      const StressCase& sc = run.cases[w.index];
+      const vines::DeviceParams& d = sc.params.device;
+      const bool dev = d.kind == vines::DeviceKind::kVines;
+      std::printf("%-12s %6lld %10.3g %10.3g %3d %-11s %-6s %8.1f %7.3f %5s %5s %6s %s%s\n", check_name(c),
+                  static_cast<long long>(sc.index), w.value, w.bound, sc.params.frame.stories,
+                  dev ? law_name(d.vines.law) : "none", scalar_name(sc.scalar), sc.params.loop.sensor_rate_hz,
+                  sc.pga_scale, design_cell(dev, d.vines.beta, 5).c_str(), design_cell(dev, d.vines.eps, 5).c_str(),
+                  design_cell(dev, 100 * d.mass_ratio, 6).c_str(),
+                  records[static_cast<std::size_t>(sc.record)].file.c_str(), w.ok ? "" : "  FAIL");
     }
-  if (!s["refusals"].empty()) {
+  if (!s.refusals.empty()) {
     std::printf("\nrefused at scene load:\n");
-    for (const auto& r : s["refusals"])
-      std::printf("  %5zu x %s (e.g. case %lld)\n", r["cases"].get<std::size_t>(),
-                  r["reason"].get<std::string>().c_str(), r["first_case"].get<long long>());
+    for (const RefusalSummary& r : s.refusals)
+      std::printf("  %5zu x %s (e.g. case %lld)\n", r.cases, r.reason.c_str(), static_cast<long long>(r.first_case));
   }
 }
 
@@ -78,22 +93,24 @@ int stress(const StressArgs& a) {
   }
   const std::atomic<bool>* stop = stop_on_interrupt();
   const StressRun run = run_stress(opt, records, stop);
-  nlohmann::json s = stress_summary(opt, run, records, a.worst);
+  StressSummary s = stress_summary(opt, run, a.worst);
+  // --out: the worst cases as scenes, stress.json, and every case run.
   if (!a.out_dir.empty()) {
-    std::filesystem::create_directories(a.out_dir);
-    for (auto& [name, c] : s["checks"].items())
-      for (auto& w : c["worst"])
-        w["scene_file"] = write_case_scene(run.cases[w["scene"]["case"].get<std::size_t>()], records, a.out_dir);
-    std::ofstream(std::filesystem::path(a.out_dir) / "stress.json") << s.dump(2) << '\n';
-    std::ofstream cases(std::filesystem::path(a.out_dir) / "cases.jsonl");
+    const std::filesystem::path dir(a.out_dir);
+    std::filesystem::create_directories(dir);
+    for (CheckSummary& c : s.checks)
+      for (WorstCase& w : c.worst) w.scene_file = write_case_scene(run.cases[w.index], records, a.out_dir);
+    std::ofstream summary(dir / "stress.json");
+    summary << s.to_json(run, records).dump(2) << '\n';
+    std::ofstream cases(dir / "cases.jsonl");
     for (std::size_t i = 0; i < run.results.size(); ++i)
       if (run.results[i].done) cases << case_report(run.cases[i], run.results[i], records).dump() << '\n';
+    if (!summary || !cases) throw std::runtime_error(a.out_dir + ": cannot write stress.json / cases.jsonl");
   }
-  const int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  if (a.as_json) std::printf("%s\n", s.dump().c_str());
-  else print_stress(s, threads);
+  if (a.as_json) std::printf("%s\n", s.to_json(run, records).dump().c_str());
+  else print_stress(s, run, records, map_threads(opt.threads));
   if (*stop) return kInterrupted;
-  return s["passed"].get<bool>() ? kOk : kRefused;
+  return s.passed ? kOk : kRefused;
 }
 
 }  // namespace

@@ -32,27 +32,24 @@ int sweep(SweepArgs a) {
   mpi.gather(&results);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
-  const nlohmann::json s = write_sweep(spec, plan, results, opt.out_dir, wall);
+  const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
   std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
-              a.spec_path.c_str(), s["done"].get<std::size_t>(), plan.size(), wall, s["runs_per_s"].get<double>(),
-              mpi.size(), mpi.size() > 1 ? "s" : "", s["failed"].get<std::size_t>(), opt.out_dir.c_str());
-  for (const auto& st : s["studies"]) {
-    if (st["x_r"].is_null()) continue;
-    std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f",
-                st["name"].get<std::string>().c_str(), st["device"].get<std::string>().c_str(),
-                st["runs"].get<std::size_t>(), 100 * st["x_r"]["mean"].get<double>(),
-                100 * st["x_r"]["sd"].get<double>(), 100 * st["x_r"]["min"].get<double>(),
-                100 * st["x_r"]["max"].get<double>(), 100 * st["E_r"]["mean"].get<double>(),
-                100 * st["E_r"]["sd"].get<double>());
-    if (st.contains("best"))
-      std::printf("  best %s = %g", st["best"]["key"].get<std::string>().c_str(), st["best"]["value"].get<double>());
+              a.spec_path.c_str(), s.done, plan.size(), wall, s.runs_per_s(), mpi.size(), mpi.size() > 1 ? "s" : "",
+              s.failed, opt.out_dir.c_str());
+  // A line per study that has results: x_r and E_r, and the best value.
+  for (const StudySummary& st : s.studies) {
+    if (!st.x_r) continue;
+    std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", st.name.c_str(),
+                st.device.c_str(), st.runs, 100 * st.x_r->mean, 100 * st.x_r->sd, 100 * st.x_r->min,
+                100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
+    if (!st.optimize.empty() && !st.groups.empty()) std::printf("  best %s = %g", st.group_by.c_str(), st.best_value);
     std::printf("\n");
   }
   if (*stop) {
-    std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s["done"].get<std::size_t>());
+    std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s.done);
     return kInterrupted;
   }
-  return s["failed"].get<std::size_t>() == 0 ? kOk : kRefused;
+  return s.failed == 0 ? kOk : kRefused;
 }
 
 }  // namespace

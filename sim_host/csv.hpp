@@ -1,0 +1,41 @@
+// One CSV writer for the files the commands write (sweep results.csv, run
+// timeseries.csv, bench --csv): comma-separated cells, one row a line; a
+// text cell is quoted when it holds a comma, a quote or a line break (quotes
+// doubled, RFC 4180), or always with quoted(); numbers in a printf format.
+// Writes are checked: a file that cannot be opened or written throws a
+// std::runtime_error naming it.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace vines::host {
+
+class CsvWriter {
+ public:
+  explicit CsvWriter(const std::string& path);  // creates or truncates the file
+  ~CsvWriter();
+  CsvWriter(const CsvWriter&) = delete;
+  CsvWriter& operator=(const CsvWriter&) = delete;
+
+  CsvWriter& text(const std::string& s);    // quoted when it must be
+  CsvWriter& quoted(const std::string& s);  // always quoted
+  CsvWriter& raw(const std::string& s);     // as is (already CSV-safe)
+  CsvWriter& number(double v, const char* format);  // e.g. "%.10g"
+  CsvWriter& integer(long long v);
+  CsvWriter& empty();                       // an empty cell
+  void end_row();
+  // Flushes and closes; throws if anything could not be written.
+  void close();
+
+ private:
+  void put(const char* s, std::size_t n);
+  void separate();
+
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  bool first_ = true;  // no cell yet in this row
+  bool failed_ = false;
+};
+
+}  // namespace vines::host

@@ -1,0 +1,231 @@
+// `vines sweep` specs: the [[study]] tables of a spec file, checked, and the
+// runs they make (format at the top of sweep.hpp).
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "sim_host/scene.hpp"
+#include "sim_host/sweep.hpp"
+
+namespace vines::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const std::string& where, const std::string& what) {
+  throw std::runtime_error(where + ": " + what);
+}
+
+// ---- spec parsing ----
+
+// A grid value list: explicit values, a range table, or a list mixing both.
+struct Scaled {
+  std::vector<KeyValue> values;
+  std::string scale;  // "", "gap" or "vmax"
+};
+
+KeyValue value_of(const std::string& where, const std::string& key, const toml::node& n) {
+  KeyValue v;
+  v.key = key;
+  if (auto i = n.as_integer()) {
+    v.number = static_cast<double>(i->get());
+    v.integral = true;
+  } else if (auto f = n.as_floating_point()) {
+    v.number = f->get();
+  } else if (auto s = n.as_string()) {
+    v.text = s->get();
+  } else if (auto b = n.as_boolean()) {
+    v.text = b->get() ? "true" : "false";
+  } else {
+    fail(where, key + ": values must be numbers, strings or booleans");
+  }
+  return v;
+}
+
+// Values of a range table {from, to, step | count, scale}.
+std::vector<double> range_values(const std::string& where, const std::string& key,
+                                 const toml::table& t, std::string* scale, bool* integral) {
+  for (auto&& kv : t)
+    if (kv.first != "from" && kv.first != "to" && kv.first != "step" && kv.first != "count" &&
+        kv.first != "scale")
+      fail(where, key + ": unknown range key '" + std::string(kv.first.str()) +
+                      "' (known: from, to, step, count, scale)");
+  const auto from = t["from"].value<double>(), to = t["to"].value<double>();
+  if (!from || !to) fail(where, key + ": a range needs numbers 'from' and 'to'");
+  if (auto s = t["scale"].value<std::string>()) {
+    if (*s != "gap" && *s != "vmax") fail(where, key + ": scale must be \"gap\" or \"vmax\"");
+    *scale = *s;
+  }
+  *integral = t["from"].is_integer() && t["to"].is_integer() && t["step"].is_integer();
+  std::vector<double> out;
+  if (auto step = t["step"].value<double>()) {
+    if (!(*step > 0)) fail(where, key + ": step must be > 0");
+    const double n = std::floor((*to - *from) / *step + 1e-9);
+    if (n < 0 || n > 1e6) fail(where, key + ": empty or huge range");
+    for (int i = 0; i <= static_cast<int>(n); ++i) {
+      const double x = *from + i * *step;
+      out.push_back(std::round(x * 1e12) / 1e12);  // 1.05 + 3 * 0.05 prints as 1.2
+    }
+  } else if (auto count = t["count"].value<int64_t>()) {
+    if (*count < 1 || *count > 1000000) fail(where, key + ": count must be in [1, 1e6]");
+    for (int64_t i = 0; i < *count; ++i)
+      out.push_back(*count == 1 ? *from : *from + (*to - *from) * static_cast<double>(i) / (*count - 1));
+  } else {
+    fail(where, key + ": a range needs 'step' or 'count'");
+  }
+  return out;
+}
+
+Scaled grid_axis(const std::string& where, const std::string& key, const toml::node& n) {
+  Scaled ax;
+  std::vector<double> numbers;
+  bool all_integral = true;
+  auto add_range = [&](const toml::table& t) {
+    std::string scale;
+    bool integral = false;
+    for (double x : range_values(where, key, t, &scale, &integral)) numbers.push_back(x);
+    all_integral &= integral;
+    if (!ax.scale.empty() && ax.scale != scale) fail(where, key + ": ranges with different scales");
+    ax.scale = scale;
+  };
+  if (auto t = n.as_table()) {
+    add_range(*t);
+  } else if (auto a = n.as_array()) {
+    for (auto&& e : *a) {
+      if (auto tt = e.as_table()) {
+        add_range(*tt);
+      } else {
+        KeyValue v = value_of(where, key, e);
+        if (!v.text.empty()) ax.values.push_back(v);
+        else { numbers.push_back(v.number); all_integral &= v.integral; }
+      }
+    }
+  } else {
+    fail(where, key + ": a grid key takes a list of values or a range table");
+  }
+  // Union of the numbers, sorted, without duplicates.
+  std::sort(numbers.begin(), numbers.end());
+  numbers.erase(std::unique(numbers.begin(), numbers.end(),
+                            [](double a, double b) { return std::fabs(a - b) <= 1e-12 * (1 + std::fabs(a)); }),
+                numbers.end());
+  for (double x : numbers) {
+    KeyValue v;
+    v.key = key;
+    v.number = x;
+    v.integral = all_integral && ax.scale.empty();
+    ax.values.push_back(v);
+  }
+  if (ax.values.empty()) fail(where, key + ": no values");
+  return ax;
+}
+
+void check_keys(const std::string& where, const toml::table& t,
+                std::initializer_list<std::string_view> known) {
+  for (auto&& kv : t)
+    if (std::find(known.begin(), known.end(), kv.first.str()) == known.end())
+      fail(where, "unknown key '" + std::string(kv.first.str()) + "'");
+}
+
+std::vector<KeyValue> key_values(const std::string& where, const toml::table& t) {
+  std::vector<KeyValue> out;
+  for (auto&& kv : t) out.push_back(value_of(where, std::string(kv.first.str()), kv.second));
+  return out;
+}
+
+}  // namespace
+
+std::string KeyValue::column() const { return scaled() ? key + "/" + text.substr(6) : key; }
+
+std::string KeyValue::label() const {
+  if (!text.empty() && !scaled()) return text;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", number);
+  return buf;
+}
+
+// ---- spec file ----
+SweepSpec load_sweep(const std::string& path) {
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    fail(path + ":" + std::to_string(e.source().begin.line), "TOML syntax error: " + std::string(e.description()));
+  }
+  check_keys(path, root, {"study"});
+  const toml::array* studies = root["study"].as_array();
+  if (!studies || studies->empty()) fail(path, "needs at least one [[study]]");
+  SweepSpec spec;
+  spec.path = path;
+  for (auto&& node : *studies) {
+    const toml::table* t = node.as_table();
+    if (!t) fail(path, "study: must be a table");
+    const std::string where = path + ":" + std::to_string(t->source().begin.line);
+    check_keys(where, *t, {"name", "scene", "group_by", "optimize", "set", "cases", "grid"});
+    StudySpec st;
+    st.name = t->at_path("name").value_or(std::string("study") + std::to_string(spec.studies.size() + 1));
+    const auto scene = t->at_path("scene").value<std::string>();
+    if (!scene) fail(where, "study '" + st.name + "': needs scene = \"file.toml\"");
+    st.scene_path = (fs::path(path).parent_path() / *scene).lexically_normal().string();
+    st.group_by = t->at_path("group_by").value_or(std::string());
+    st.optimize = t->at_path("optimize").value_or(std::string());
+    if (!st.optimize.empty() && st.optimize != "x_r" && st.optimize != "E_r")
+      fail(where, "optimize must be \"x_r\" or \"E_r\"");
+    if (auto s = t->at_path("set").as_table()) st.set = key_values(where, *s);
+    if (auto c = t->at_path("cases").as_array())
+      for (auto&& e : *c) {
+        if (!e.as_table()) fail(where, "cases: each case is a table of key = value");
+        st.cases.push_back(key_values(where, *e.as_table()));
+      }
+    if (auto g = t->at_path("grid").as_table())
+      for (auto&& kv : *g) {
+        Scaled ax = grid_axis(where, std::string(kv.first.str()), kv.second);
+        if (!ax.scale.empty())
+          for (KeyValue& v : ax.values) v.text = "scale:" + ax.scale;
+        st.grid_axes.push_back(ax.values);
+      }
+    // Every key this study sets (fixed, per case, per grid axis) is a scene key.
+    auto check_key = [&](const KeyValue& v) {
+      if (v.key.find('.') == std::string::npos) fail(where, v.key + ": keys are table.key");
+    };
+    for (const KeyValue& v : st.set) check_key(v);
+    for (const auto& c : st.cases)
+      for (const KeyValue& v : c) check_key(v);
+    for (const auto& ax : st.grid_axes) check_key(ax.front());
+    if (!st.group_by.empty()) {
+      bool found = false;
+      for (const auto& ax : st.grid_axes) found |= ax.front().key == st.group_by;
+      if (!found) fail(where, "group_by '" + st.group_by + "' is not a grid key");
+    }
+    spec.studies.push_back(st);
+  }
+  // Every study's scene must load.
+  for (const StudySpec& st : spec.studies) load_scene(st.scene_path);
+  return spec;
+}
+
+std::vector<RunPlan> plan_runs(const SweepSpec& spec) {
+  std::vector<RunPlan> out;
+  for (int s = 0; s < static_cast<int>(spec.studies.size()); ++s) {
+    const StudySpec& st = spec.studies[s];
+    const std::vector<std::vector<KeyValue>> cases = st.cases.empty() ? std::vector<std::vector<KeyValue>>{{}} : st.cases;
+    for (const auto& c : cases) {
+      // Odometer over the grid axes, last axis fastest.
+      std::vector<std::size_t> idx(st.grid_axes.size(), 0);
+      while (true) {
+        RunPlan r{s, c};
+        for (std::size_t a = 0; a < idx.size(); ++a) r.values.push_back(st.grid_axes[a][idx[a]]);
+        out.push_back(r);
+        std::size_t a = idx.size();
+        while (a > 0 && ++idx[a - 1] == st.grid_axes[a - 1].size()) idx[--a] = 0;
+        if (a == 0) break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace vines::host
