@@ -5,18 +5,17 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
 #include <random>
 #include <stdexcept>
-#include <thread>
 
-#include "sim_host/hil_child.hpp"
+#include "sim_host/hil_boards.hpp"
 #include "sim_host/hil_faults.hpp"
 #include "sim_host/hil_lab.hpp"
-#include "sim_host/hil_plant.hpp"
+#include "sim_host/hil_link.hpp"
+#include "sim_host/hil_offline.hpp"
 #include "sim_host/run.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
@@ -26,84 +25,8 @@ namespace vines::host {
 namespace {
 
 using nlohmann::json;
-using Clock = std::chrono::steady_clock;
+using Clock = HilClock;
 using link::Telemetry;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// The model image of a node's configuration (model_image.hpp): what the
-// bench sends so that no node builds a model. Hybrid nodes build the bare
-// frame themselves (host only) and get none.
-std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what) {
-  if (cfg.mode == link::NodeMode::kHybrid) return {};
-  const Scalar scalar = cfg.scalar ? Scalar::kFloat : Scalar::kDouble;
-  std::unique_ptr<Engine> eng = make_engine(cfg.scene, scalar);
-  if (!eng) throw std::runtime_error(what + ": " + missing_engine(cfg.scene, scalar));
-  const ParamError e = eng->build(cfg.scene);
-  if (!e.ok()) throw std::runtime_error(what + ": " + e.field + ": " + e.message);
-  return eng->model_image();
-}
-
-// The board a "qemu:TARGET" node runs on: QEMU machine, scalar, and the
-// preset whose build holds its images.
-struct Board {
-  const char* target;
-  const char* machine;
-  Scalar scalar;
-};
-constexpr Board kBoards[] = {{"cortex-m4f", "mps2-an386", Scalar::kFloat}, {"cortex-m7", "mps2-an500", Scalar::kDouble}};
-// QEMU runs the boards with -icount shift=3: one instruction per 8 ns of
-// virtual time, so one tick of the 25 MHz counter is 5 instructions.
-constexpr int kIcountShift = 3;
-constexpr double kInstructionsPerTick = 40.0 / (1 << kIcountShift);
-
-const Board* board_of(const std::string& node) {
-  for (const Board& b : kBoards)
-    if (node == std::string("qemu:") + b.target) return &b;
-  return nullptr;
-}
-
-// The board image for a scene's device (firmware/app: one per device).
-std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) {
-  std::string dev;
-  const DeviceParams& d = sc.params.device;
-  if (d.kind == DeviceKind::kNone) dev = "none";
-  else if (d.kind == DeviceKind::kTmd) dev = "tmd";
-  else if (d.vines.law == ContactLaw::kKuwabara) dev = "vines";
-  else
-    throw std::runtime_error(sc.path + ": --node " + opt.node +
-                             ": the board images run the bare frame, the TMD and the VI NES with the Kuwabara law");
-  if (sc.params.frame.stories != 10)
-    throw std::runtime_error(sc.path + ": --node " + opt.node + ": the board images are built for 10 stories");
-  const std::string path = !opt.image.empty() ? opt.image
-                                              : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +
-                                                    "/firmware/app/vines_node_" + dev + ".elf";
-  std::ifstream f(path);
-  if (!f)
-    throw std::runtime_error("--node " + opt.node + ": no board image " + path + " (build it: cmake --preset " +
-                             b.target + " && cmake --build --preset " + b.target + ")");
-  return path;
-}
-
-// The offline run: the scene's engine stepped in this process, read exactly
-// as the node reads it (HostPlant), so equal code gives equal bits.
-std::vector<Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
-                                   const std::string& what) {
-  HostPlant plant;
-  char msg[64] = {};
-  const std::vector<std::uint8_t> image = model_image(cfg, what);
-  plant.image_begin(static_cast<std::uint32_t>(image.size()));
-  plant.image_push(image.data(), image.size());
-  if (!plant.configure(cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
-  std::vector<Telemetry> out(samples.size());
-  plant.init(samples[0], 0);
-  plant.read(&out[0]);
-  for (std::size_t k = 1; k < samples.size(); ++k) {
-    plant.step(samples[k], 0);
-    plant.read(&out[k]);
-  }
-  return out;
-}
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -115,164 +38,6 @@ bool equal_outputs(const Telemetry& a, const Telemetry& b) {
   return same_bits(a.acc_top, b.acc_top) && same_bits(a.elastic_energy, b.elastic_energy) &&
          same_bits(a.particle_x, b.particle_x) && same_bits(a.particle_v, b.particle_v) &&
          same_bits(a.contact_force, b.contact_force) && same_bits(a.dissipated, b.dissipated);
-}
-
-// One node process and the bench's end of its link.
-class NodeLink {
- public:
-  NodeLink(const HilOptions& opt, long long life, std::vector<link::Fault>* faults,
-           std::vector<long long>* fault_life)
-      : opt_(opt), life_(life), faults_(faults), fault_life_(fault_life), name_(argv(opt)[0]),
-        child_(argv(opt)) {}
-
-  static std::vector<std::string> argv(const HilOptions& opt) {
-    if (!opt.image.empty() && opt.node.rfind("qemu:", 0) == 0) {
-      const Board* b = board_of(opt.node);
-      return {"qemu-system-arm", "-M", b->machine, "-display", "none", "-monitor", "none",
-              "-semihosting-config", "enable=on,target=native", "-serial", "stdio",
-              "-icount", "shift=" + std::to_string(kIcountShift) + ",align=off,sleep=off", "-kernel", opt.image};
-    }
-    std::vector<std::string> a = {opt.node_command.empty() ? self_exe() : opt.node_command, "node"};
-    if (opt.realtime) a.push_back("--realtime");
-    return a;
-  }
-
-  std::uint16_t next_seq() const { return seq_; }
-
-  // Encodes one frame (seq taken now) without sending it.
-  template <class Msg>
-  std::vector<std::uint8_t> encode(link::MsgType type, const Msg& m) {
-    std::uint8_t payload[link::kMaxPayload];
-    const std::size_t n = link::encode(m, payload, sizeof payload);
-    std::vector<std::uint8_t> w(link::kMaxWire);
-    w.resize(link::encode_frame(type, seq_++, payload, n, w.data(), w.size()));
-    return w;
-  }
-  std::vector<std::uint8_t> encode_empty(link::MsgType type) {
-    std::vector<std::uint8_t> w(link::kMaxWire);
-    w.resize(link::encode_frame(type, seq_++, nullptr, 0, w.data(), w.size()));
-    return w;
-  }
-
-  void send(const std::vector<std::uint8_t>& bytes) {
-    try {
-      child_.write_all(bytes.data(), bytes.size(), opt_.timeout_s);
-    } catch (const std::runtime_error& e) {
-      throw std::runtime_error(name_ + ": " + e.what());
-    }
-    delimiters_ += static_cast<std::uint32_t>(std::count(bytes.begin(), bytes.end(), 0));
-  }
-
-  // Reads and dispatches what the node sent within timeout_s.
-  void pump(double timeout_s) {
-    buf_.clear();
-    const bool open = child_.read_some(&buf_, timeout_s);
-    const double now = seconds_since(t0_);
-    for (std::uint8_t b : buf_) {
-      const link::DecodeResult r = dec_.push(b);
-      if (r == link::DecodeResult::kNone) continue;
-      if (r != link::DecodeResult::kFrame) {
-        ++bad_frames_;
-        continue;
-      }
-      const link::Frame& f = dec_.frame();
-      if (f.type == link::MsgType::kTelemetry) {
-        Telemetry t;
-        if (!link::decode(f.payload, f.length, &t)) ++bad_frames_;
-        else on_telemetry(t, now), acked_ = std::max(acked_, t.rx);
-      } else if (f.type == link::MsgType::kFault) {
-        link::Fault x;
-        if (!link::decode(f.payload, f.length, &x)) ++bad_frames_;
-        else faults_->push_back(x), fault_life_->push_back(life_), acked_ = std::max(acked_, x.rx);
-      } else if (f.type == link::MsgType::kStatus) {
-        if (!link::decode(f.payload, f.length, &status_)) {
-          ++bad_frames_;
-        } else {
-          if (statuses_++ == 0) first_cold_start_ = status_.cold_start == 1 && status_.steps == 0;
-          acked_ = std::max(acked_, status_.rx);
-        }
-      } else {
-        ++bad_frames_;
-      }
-    }
-    // A node ends after answering STOP; before that, an exit is a failure.
-    if (!open && acked_ < delimiters_)
-      throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) + 
-                               ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
-  }
-
-  // Waits until the node has answered every frame sent (lock step).
-  // Waits until at most `in_flight` frames sent are still unanswered (0:
-  // lock step).
-  void wait_answered(std::uint32_t in_flight = 0) {
-    const auto end = Clock::now() + std::chrono::duration<double>(opt_.timeout_s);
-    while (acked_ + in_flight < delimiters_) {
-      const double left = std::chrono::duration<double>(end - Clock::now()).count();
-      if (left <= 0)
-        throw std::runtime_error("node " + name_ + ": no answer within " + std::to_string(opt_.timeout_s) + " s to frame " +
-                                 std::to_string(delimiters_) + " (--timeout)");
-      pump(std::min(left, 0.05));
-    }
-  }
-
-  std::function<void(const Telemetry&, double)> on_telemetry;
-  const link::Status& status() const { return status_; }
-  // The node's first status said it had just powered up (state lost).
-  bool first_cold_start() const { return first_cold_start_; }
-  long long bad_frames() const { return bad_frames_; }
-  void set_epoch(Clock::time_point t0) { t0_ = t0; }
-  void kill() { child_.kill_now(); }
-  int finish() { return child_.finish(opt_.timeout_s); }
-
- private:
-  const HilOptions& opt_;
-  long long life_;
-  std::vector<link::Fault>* faults_;
-  std::vector<long long>* fault_life_;
-  std::string name_;
-  ChildProcess child_;
-  link::Decoder dec_;
-  std::vector<std::uint8_t> buf_;
-  std::uint16_t seq_ = 0;
-  std::uint32_t delimiters_ = 0, acked_ = 0;
-  link::Status status_;
-  long long statuses_ = 0, bad_frames_ = 0;
-  bool first_cold_start_ = false;
-  Clock::time_point t0_ = Clock::now();
-};
-
-// Sends one part of the configuration in chunks.
-void send_part(NodeLink& node, link::ConfigPart part, const std::uint8_t* bytes, std::size_t n) {
-  const std::uint32_t crc = link::crc32(bytes, n);
-  for (std::size_t off = 0; off < n; off += link::kChunk) {
-    link::ConfigureChunk c{part, static_cast<std::uint32_t>(off), static_cast<std::uint32_t>(n), crc, bytes + off,
-                           static_cast<std::uint16_t>(std::min(link::kChunk, n - off))};
-    node.send(node.encode(link::MsgType::kConfigure, c));
-  }
-}
-
-// Configures a fresh node: the model image (if any), then the settings.
-void configure(NodeLink& node, const link::NodeConfig& cfg, const std::vector<std::uint8_t>& image) {
-  if (!image.empty()) {
-    send_part(node, link::ConfigPart::kModelImage, image.data(), image.size());
-    node.wait_answered();
-    if (node.status().message[0] != '\0')
-      throw std::runtime_error(std::string("node refused the model image: ") + node.status().message);
-  }
-  std::uint8_t blob[link::kMaxConfigBlob];
-  const std::size_t n = link::encode(cfg, blob, sizeof blob);
-  if (n == 0) throw std::runtime_error("configuration does not fit the link");
-  send_part(node, link::ConfigPart::kSettings, blob, n);
-  node.wait_answered();
-  if (node.status().state != link::NodeState::kConfigured)
-    throw std::runtime_error(std::string("node refused the configuration: ") + node.status().message);
-}
-
-// Starts a configured node at sample k0 (bench clock t_ns).
-void start(NodeLink& node, long long k0, std::uint64_t t_ns) {
-  node.send(node.encode(link::MsgType::kStart, link::Start{static_cast<std::uint32_t>(k0), t_ns}));
-  node.wait_answered();
-  if (node.status().state != link::NodeState::kRunning) throw std::runtime_error("node did not start");
 }
 
 link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
@@ -304,12 +69,6 @@ json stats(std::vector<double> v) {
 }
 
 }  // namespace
-
-std::vector<std::string> node_names() {
-  std::vector<std::string> names = {"host"};
-  for (const Board& b : kBoards) names.push_back(std::string("qemu:") + b.target);
-  return names;
-}
 
 json run_hil(const Scene& scene, const HilOptions& opt) {
   if (opt.mode != "replay" && opt.mode != "twin" && opt.mode != "hybrid")
