@@ -40,12 +40,13 @@ bool equal_outputs(const Telemetry& a, const Telemetry& b) {
          same_bits(a.contact_force, b.contact_force) && same_bits(a.dissipated, b.dissipated);
 }
 
+constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
+
 link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   link::NodeConfig c;
   c.scene = scene.params;
   c.scalar = scene.scalar == Scalar::kFloat ? 1 : 0;
-  c.mode = opt.mode == "twin" ? link::NodeMode::kTwin : opt.mode == "hybrid" ? link::NodeMode::kHybrid
-                                                                          : link::NodeMode::kReplay;
+  c.mode = kNodeModes[static_cast<int>(opt.mode)];
   c.sensor_range_mps2 = opt.saturate_g * kGravity;
   c.grace_periods = opt.grace_periods;
   c.stall_periods = opt.node_stall_periods;
@@ -71,8 +72,6 @@ json stats(std::vector<double> v) {
 }  // namespace
 
 json run_hil(const Scene& scene, const HilOptions& opt) {
-  if (opt.mode != "replay" && opt.mode != "twin" && opt.mode != "hybrid")
-    throw std::runtime_error("--mode " + opt.mode + ": must be replay, twin or hybrid");
   Scene sc = scene;
   if (opt.duration_s > 0) sc.duration_s = opt.duration_s;
   HilOptions o = opt;
@@ -80,7 +79,7 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
   if (o.node.rfind("qemu:", 0) == 0) {
     board = board_of(o.node);
     if (!board) throw std::runtime_error("--node " + o.node + ": must be host, qemu:cortex-m4f or qemu:cortex-m7");
-    if (o.mode == "hybrid")
+    if (o.mode == HilMode::kHybrid)
       throw std::runtime_error("--node " + o.node + ": hybrid mode runs on the host node only");
     if (o.realtime)
       throw std::runtime_error("--node " + o.node + ": QEMU counts instructions, not wall time: use the virtual clock");
@@ -94,7 +93,7 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
   const Excitation ex = load_excitation(sc, "");
   const long long K = static_cast<long long>(ex.samples.size());
   const double h = 1.0 / sc.params.loop.sensor_rate_hz;
-  const bool hybrid = opt.mode == "hybrid", twin = opt.mode == "twin";
+  const bool hybrid = opt.mode == HilMode::kHybrid, twin = opt.mode == HilMode::kTwin;
   if (hybrid && (sc.params.device.kind != DeviceKind::kVines || sc.params.device.vines.law == ContactLaw::kRestitution))
     throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law "
                              "(hertz, tsuji or kuwabara): the table's load cell measures contact forces");
@@ -356,7 +355,7 @@ json run_hil(const Scene& scene, const HilOptions& opt) {
 
   json j;
   j["scene"] = sc.name;
-  j["mode"] = o.mode;
+  j["mode"] = hil_mode_name(o.mode);
   j["clock"] = o.realtime ? "realtime" : "virtual";
   j["scalar"] = scalar_name(sc.scalar);
   j["sensor_rate_hz"] = sc.params.loop.sensor_rate_hz;

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/hil.hpp"
+#include "sim_host/hil_options.hpp"
 #include "sim_host/scalar.hpp"
 #include "sim_host/scene.hpp"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "sim_host/hil_child.hpp"
-#include "sim_host/hil.hpp"
+#include "sim_host/hil_options.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"

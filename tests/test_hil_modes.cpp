@@ -18,7 +18,7 @@ namespace {
 
 Scene vines_scene() { return load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml"); }
 
-HilOptions base(const char* mode, double duration_s) {
+HilOptions base(HilMode mode, double duration_s) {
   HilOptions o;
   o.node_command = VINES_EXE;
   o.mode = mode;
@@ -36,7 +36,7 @@ TEST(HilTwin, ResidualGrowsWithDamageAndRaisesTheAlarm) {
   for (const char* scene : {"elcentro_bare", "elcentro_vines"}) {
     double last = -1;
     for (double eta : {1.0, 0.95, 0.85, 0.7}) {
-      HilOptions o = base("twin", 20.0);
+      HilOptions o = base(HilMode::kTwin, 20.0);
       o.truth_stiffness_scale = eta;
       o.measure_noise_mps2 = 0.02;
       o.residual_limit_mps2 = 0.1;
@@ -61,7 +61,7 @@ TEST(HilTwin, ResidualGrowsWithDamageAndRaisesTheAlarm) {
 }
 
 TEST(HilTwin, DriftAlarmsNameTheStories) {
-  HilOptions o = base("twin", 10.0);
+  HilOptions o = base(HilMode::kTwin, 10.0);
   o.drift_limit_m = 0.02;
   const nlohmann::json j = run_hil(vines_scene(), o);
   const auto& t = j["twin"];
@@ -76,7 +76,7 @@ TEST(HilTwin, DriftAlarmsNameTheStories) {
 // a few mm) are so sensitive to the table's error that the hybrid response
 // still departs from the pure simulation; it stays bounded.
 TEST(HilHybrid, CompensationReducesTrackingError) {
-  HilOptions with = base("hybrid", 20.0), without = base("hybrid", 20.0);
+  HilOptions with = base(HilMode::kHybrid, 20.0), without = base(HilMode::kHybrid, 20.0);
   without.comp_delay_s = 0;
   const nlohmann::json a = run_hil(vines_scene(), with), b = run_hil(vines_scene(), without);
   const auto &ha = a["hybrid"], &hb = b["hybrid"];
@@ -93,7 +93,7 @@ TEST(HilHybrid, CompensationReducesTrackingError) {
 // With a near-ideal actuator (2 kHz, no delay, no sensor noise) the hybrid
 // peak comes within 5 % of the pure simulation's: the coupling is right.
 TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
-  HilOptions o = base("hybrid", 20.0);
+  HilOptions o = base(HilMode::kHybrid, 20.0);
   o.actuator_hz = 2000;
   o.actuator_delay_s = 0;
   o.force_noise_n = 0;
@@ -108,7 +108,7 @@ TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
 
 TEST(HilHybrid, RefusesAnInstantaneousLaw) {
   Scene sc = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines_restitution.toml");
-  EXPECT_THROW(run_hil(sc, base("hybrid", 1.0)), std::runtime_error);
+  EXPECT_THROW(run_hil(sc, base(HilMode::kHybrid, 1.0)), std::runtime_error);
 }
 
 // A node given a frame with a NaN mass refuses it and names the field.

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
@@ -106,9 +107,15 @@ void add_hil(CLI::App& vines) {
       "(hybrid) modes.",
       "SPEC of a fault: a rate per sample from 0 to 1, or @K1,K2,... sample indices.", [a] { return hil(*a); });
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
-  cmd->add_option("--mode", opt.mode, "replay (default), twin (digital-twin monitor), hybrid (shake table)")
+  const std::vector<std::string> modes(std::begin(host::kHilModeNames), std::end(host::kHilModeNames));
+  cmd->add_option_function<std::string>(
+         "--mode",
+         [&opt, modes](const std::string& v) {
+           opt.mode = static_cast<host::HilMode>(std::find(modes.begin(), modes.end(), v) - modes.begin());
+         },
+         "replay (default), twin (digital-twin monitor), hybrid (shake table)")
       ->type_name("replay|twin|hybrid")
-      ->check(CLI::IsMember({"replay", "twin", "hybrid"}));
+      ->check(CLI::IsMember(modes));
   cmd->add_flag("--realtime,!--virtual-clock", opt.realtime,
                 "pace samples at the sensor rate on the wall clock; or (default) lock step, as fast as the link "
                 "allows (the node's clock is the samples' stamps)");
