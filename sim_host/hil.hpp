@@ -10,9 +10,8 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "sim_host/hil_options.hpp"
+#include "sim_host/hil_report.hpp"
 #include "sim_host/scene.hpp"
 
 namespace vines::host {
@@ -20,9 +19,10 @@ namespace vines::host {
 // The nodes HilOptions::node names: "host", then "qemu:TARGET" for each board.
 std::vector<std::string> node_names();
 
-// Runs the bench; returns the report. Throws std::runtime_error naming the
-// input (scene, option, node) on any error the user can cause.
-nlohmann::json run_hil(const Scene& scene, const HilOptions& opt);
+// Runs the bench; returns the report (to_json in hil_report.hpp). Throws
+// std::runtime_error naming the input (scene, option, node) on any error the
+// user can cause.
+HilReport run_hil(const Scene& scene, const HilOptions& opt);
 
 // `vines node`: the host firmware node on stdin/stdout, deadlines on the local
 // clock with realtime; it gives up after idle_timeout_s without a byte.
