@@ -7,69 +7,22 @@
 // real-time hybrid simulation with an actuator and the VI NES on the table).
 #pragma once
 
-#include <cstdint>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "sim_host/hil_options.hpp"
+#include "sim_host/hil_report.hpp"
 #include "sim_host/scene.hpp"
 
 namespace vines::host {
 
-// When a fault is injected: with a probability per sample, or at samples.
-struct FaultSpec {
-  double rate = 0;
-  std::vector<long long> at;
-  bool any() const { return rate > 0 || !at.empty(); }
-};
-
-enum class FaultKind { kDrop, kCorrupt, kDuplicate, kReorder, kLate, kNonFinite, kSaturate, kStall, kRestart, kCount };
-inline constexpr int kFaultKinds = static_cast<int>(FaultKind::kCount);
-const char* fault_kind_name(FaultKind k);
-
-struct HilOptions {
-  std::string mode = "replay";  // replay | twin | hybrid
-  bool realtime = false;
-  double duration_s = 0;        // 0: the scene's
-  std::string csv;              // "" : none
-  double timeout_s = 0;         // longest wait for the node (0: 5 s, 60 s for a board in QEMU)
-  double deadline_periods = 1;  // telemetry k due by (k + this) h
-  unsigned long long seed = 1;
-  FaultSpec faults[kFaultKinds];
-  int late_periods = 3, stall_periods = 20;
-  double saturate_g = 0;        // sensor range (0: none)
-  // node fault policy
-  double grace_periods = 1.5, node_stall_periods = 10;
-  // twin
-  double truth_stiffness_scale = 1;  // the bench's building (eta_k)
-  double measure_noise_mps2 = 0;
-  double drift_limit_m = 0;          // every story (0: no alarm)
-  double residual_limit_mps2 = 0.05;
-  double residual_window_s = 1.0;
-  // hybrid
-  double actuator_hz = 20, actuator_zeta = 0.7, actuator_delay_s = 0.005;
-  double force_noise_n = 50, force_lsb_n = 10;
-  double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
-  int comp_order = 2;
-  // The node: "host" (this program's `vines node`), "qemu:cortex-m4f" or
-  // "qemu:cortex-m7" (the board image in QEMU, instructions counted), or the
-  // path of a program that speaks the link on stdin/stdout.
-  std::string node = "host";
-  std::string node_command;       // host node: the program run as `PROGRAM node` ("" : this one)
-  std::string image;              // qemu: the board image ("" : the preset build's)
-  std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
-};
-
 // The nodes HilOptions::node names: "host", then "qemu:TARGET" for each board.
 std::vector<std::string> node_names();
 
-// Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.
-FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
-
-// Runs the bench; returns the report. Throws std::runtime_error naming the
-// input (scene, option, node) on any error the user can cause.
-nlohmann::json run_hil(const Scene& scene, const HilOptions& opt);
+// Runs the bench; returns the report (to_json in hil_report.hpp). Throws
+// std::runtime_error naming the input (scene, option, node) on any error the
+// user can cause.
+HilReport run_hil(const Scene& scene, const HilOptions& opt);
 
 // `vines node`: the host firmware node on stdin/stdout, deadlines on the local
 // clock with realtime; it gives up after idle_timeout_s without a byte.

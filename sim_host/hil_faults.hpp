@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "sim_host/hil.hpp"
+#include "sim_host/hil_options.hpp"
 
 namespace vines::host {
 

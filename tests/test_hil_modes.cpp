@@ -18,7 +18,7 @@ namespace {
 
 Scene vines_scene() { return load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml"); }
 
-HilOptions base(const char* mode, double duration_s) {
+HilOptions base(HilMode mode, double duration_s) {
   HilOptions o;
   o.node_command = VINES_EXE;
   o.mode = mode;
@@ -36,39 +36,40 @@ TEST(HilTwin, ResidualGrowsWithDamageAndRaisesTheAlarm) {
   for (const char* scene : {"elcentro_bare", "elcentro_vines"}) {
     double last = -1;
     for (double eta : {1.0, 0.95, 0.85, 0.7}) {
-      HilOptions o = base("twin", 20.0);
+      HilOptions o = base(HilMode::kTwin, 20.0);
       o.truth_stiffness_scale = eta;
       o.measure_noise_mps2 = 0.02;
       o.residual_limit_mps2 = 0.1;
-      const nlohmann::json j =
-          run_hil(load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/" + scene + ".toml"), o);
-      const auto& t = j["twin"];
-      SCOPED_TRACE(std::string(scene) + ": " + t.dump());
-      const double rms = t["residual_rms_mps2"].get<double>();
+      const HilReport r = run_hil(load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/" + scene + ".toml"), o);
+      ASSERT_TRUE(r.twin);
+      const HilTwinReport& t = *r.twin;
+      SCOPED_TRACE(std::string(scene) + ": " + to_json(r)["twin"].dump());
+      const double rms = t.residual_rms_mps2;
       if (eta == 1.0) {
         EXPECT_NEAR(rms, 0.02, 0.002);  // the noise alone
-        EXPECT_EQ(t["residual_alarm_steps"].get<long long>(), 0);
+        EXPECT_EQ(t.residual_alarm_steps, 0);
       } else {
         EXPECT_GT(rms, last);
         EXPECT_GT(rms, 0.5);
-        EXPECT_GT(t["residual_alarm_steps"].get<long long>(), 0);
-        EXPECT_LT(t["first_residual_alarm_s"].get<double>(), 3.0);
+        EXPECT_GT(t.residual_alarm_steps, 0);
+        ASSERT_TRUE(t.first_residual_alarm_s);
+        EXPECT_LT(*t.first_residual_alarm_s, 3.0);
       }
-      EXPECT_TRUE(j["bit_exact"].get<bool>());  // predictions: the offline run of the nominal model
+      EXPECT_TRUE(r.bit_exact);  // predictions: the offline run of the nominal model
       last = rms;
     }
   }
 }
 
 TEST(HilTwin, DriftAlarmsNameTheStories) {
-  HilOptions o = base("twin", 10.0);
+  HilOptions o = base(HilMode::kTwin, 10.0);
   o.drift_limit_m = 0.02;
-  const nlohmann::json j = run_hil(vines_scene(), o);
-  const auto& t = j["twin"];
-  EXPECT_GT(t["drift_alarm_steps"].get<long long>(), 0);
-  EXPECT_FALSE(t["stories_alarmed"].empty());
+  const HilReport r = run_hil(vines_scene(), o);
+  ASSERT_TRUE(r.twin);
+  EXPECT_GT(r.twin->drift_alarm_steps, 0);
+  EXPECT_FALSE(r.twin->stories_alarmed.empty());
   o.drift_limit_m = 1.0;  // beyond any drift of this record
-  EXPECT_EQ(run_hil(vines_scene(), o)["twin"]["drift_alarm_steps"].get<long long>(), 0);
+  EXPECT_EQ(run_hil(vines_scene(), o).twin->drift_alarm_steps, 0);
 }
 
 // A 20 Hz servo with 5 ms delay: extrapolating the command over the delay and
@@ -76,39 +77,39 @@ TEST(HilTwin, DriftAlarmsNameTheStories) {
 // a few mm) are so sensitive to the table's error that the hybrid response
 // still departs from the pure simulation; it stays bounded.
 TEST(HilHybrid, CompensationReducesTrackingError) {
-  HilOptions with = base("hybrid", 20.0), without = base("hybrid", 20.0);
+  HilOptions with = base(HilMode::kHybrid, 20.0), without = base(HilMode::kHybrid, 20.0);
   without.comp_delay_s = 0;
-  const nlohmann::json a = run_hil(vines_scene(), with), b = run_hil(vines_scene(), without);
-  const auto &ha = a["hybrid"], &hb = b["hybrid"];
-  SCOPED_TRACE(ha.dump() + "\n" + hb.dump());
-  EXPECT_GT(ha["compensation_delay_s"].get<double>(), 0.005);
-  EXPECT_LT(ha["tracking_rms_m"].get<double>(), 0.2 * hb["tracking_rms_m"].get<double>());
-  EXPECT_LT(ha["tracking_peak_m"].get<double>(), hb["tracking_peak_m"].get<double>());
-  for (const auto* j : {&a, &b}) {
-    EXPECT_TRUE((*j)["outputs_finite"].get<bool>());
-    EXPECT_LT((*j)["hybrid"]["peak_top_hybrid_m"].get<double>(), 2 * (*j)["hybrid"]["peak_top_pure_m"].get<double>());
+  const HilReport a = run_hil(vines_scene(), with), b = run_hil(vines_scene(), without);
+  ASSERT_TRUE(a.hybrid && b.hybrid);
+  const HilHybridReport &ha = *a.hybrid, &hb = *b.hybrid;
+  SCOPED_TRACE(to_json(a)["hybrid"].dump() + "\n" + to_json(b)["hybrid"].dump());
+  EXPECT_GT(ha.compensation_delay_s, 0.005);
+  EXPECT_LT(ha.tracking_rms_m, 0.2 * hb.tracking_rms_m);
+  EXPECT_LT(ha.tracking_peak_m, hb.tracking_peak_m);
+  for (const HilReport* r : {&a, &b}) {
+    EXPECT_TRUE(r->outputs_finite);
+    EXPECT_LT(r->hybrid->peak_top_hybrid_m, 2 * r->hybrid->peak_top_pure_m);
   }
 }
 
 // With a near-ideal actuator (2 kHz, no delay, no sensor noise) the hybrid
 // peak comes within 5 % of the pure simulation's: the coupling is right.
 TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
-  HilOptions o = base("hybrid", 20.0);
+  HilOptions o = base(HilMode::kHybrid, 20.0);
   o.actuator_hz = 2000;
   o.actuator_delay_s = 0;
   o.force_noise_n = 0;
   o.force_lsb_n = 0;
   o.comp_delay_s = 0.001;  // the one-step lag of the command
-  const nlohmann::json j = run_hil(vines_scene(), o);
-  const auto& hy = j["hybrid"];
-  EXPECT_NEAR(hy["peak_top_hybrid_m"].get<double>(), hy["peak_top_pure_m"].get<double>(),
-              0.05 * hy["peak_top_pure_m"].get<double>())
-      << hy.dump();
+  const HilReport r = run_hil(vines_scene(), o);
+  ASSERT_TRUE(r.hybrid);
+  const HilHybridReport& hy = *r.hybrid;
+  EXPECT_NEAR(hy.peak_top_hybrid_m, hy.peak_top_pure_m, 0.05 * hy.peak_top_pure_m) << to_json(r)["hybrid"].dump();
 }
 
 TEST(HilHybrid, RefusesAnInstantaneousLaw) {
   Scene sc = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines_restitution.toml");
-  EXPECT_THROW(run_hil(sc, base("hybrid", 1.0)), std::runtime_error);
+  EXPECT_THROW(run_hil(sc, base(HilMode::kHybrid, 1.0)), std::runtime_error);
 }
 
 // A node given a frame with a NaN mass refuses it and names the field.

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
@@ -21,58 +22,57 @@ struct HilArgs {
 };
 
 // The hil report as text.
-void print_hil(const nlohmann::json& j) {
-  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", j["scene"].get<std::string>().c_str(),
-              j["mode"].get<std::string>().c_str(), j["clock"].get<std::string>().c_str(),
-              j["scalar"].get<std::string>().c_str(), j["sensor_rate_hz"].get<double>(),
-              j["node"].get<std::string>().c_str());
-  const auto& nd = j["node_deadline"];
+void print_hil(const host::HilReport& r) {
+  std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", r.scene.c_str(), host::hil_mode_name(r.mode),
+              r.realtime ? "realtime" : "virtual", scalar_name(r.scalar), r.sensor_rate_hz, r.node.c_str());
+  // The node's deadline monitor (and a board's instruction counts)
+  const link::StepTiming& nd = r.node_deadline;
   std::printf("  node deadline monitor: %lld overruns of a %lld-tick budget, worst step %lld ticks (k %lld)",
-              nd["overruns"].get<long long>(), nd["budget_ticks"].get<long long>(), nd["worst_ticks"].get<long long>(),
-              nd["worst_k"].get<long long>());
-  if (j.contains("worst_step_instructions"))
-    std::printf("; %.0f instructions (median %.0f)", j["worst_step_instructions"].get<double>(),
-                j["median_step_instructions"].get<double>());
-  if (nd["stack_peak_bytes"].get<long long>() > 0) std::printf("; stack %lld B", nd["stack_peak_bytes"].get<long long>());
+              static_cast<long long>(nd.overruns), static_cast<long long>(nd.budget_ticks),
+              static_cast<long long>(nd.worst_ticks), static_cast<long long>(nd.worst_k));
+  if (r.board)
+    std::printf("; %.0f instructions (median %.0f)", r.board->worst_step_instructions,
+                r.board->median_step_instructions);
+  if (nd.stack_peak_bytes > 0) std::printf("; stack %lld B", static_cast<long long>(nd.stack_peak_bytes));
   std::printf("\n");
-  std::printf("  steps %lld of %lld, deadline misses %lld (deadline %.3g ms)", j["steps"].get<long long>(),
-              j["samples"].get<long long>(), j["deadline_misses"].get<long long>(), 1e3 * j["deadline_s"].get<double>());
-  if (!j["latency_us"].is_null())
-    std::printf(", latency mean %.0f us, p99 %.0f us, max %.0f us", j["latency_us"]["mean"].get<double>(),
-                j["latency_us"]["p99"].get<double>(), j["latency_us"]["max"].get<double>());
-  std::printf("\n  faults injected %lld, detected %lld, survived %lld; node restarts %lld\n",
-              j["faults_injected"].get<long long>(), j["faults_detected"].get<long long>(),
-              j["faults_survived"].get<long long>(), j["node_restarts"].get<long long>());
-  for (const auto& [name, c] : j["faults"].items())
-    std::printf("    %-10s injected %5lld  detected %5lld  survived %5lld\n", name.c_str(), c["injected"].get<long long>(),
-                c["detected"].get<long long>(), c["survived"].get<long long>());
-  std::printf("  max deviation from offline %.3g m%s; outputs finite: %s\n", j["max_deviation_from_offline"].get<double>(),
-              j["bit_exact"].get<bool>() ? " (bit for bit equal)" : "", j["outputs_finite"].get<bool>() ? "yes" : "NO");
-  if (j.contains("twin")) {
-    const auto& t = j["twin"];
-    std::printf("  twin: eta_k %.3g, residual RMS %.4g m/s^2 (max %.4g), residual alarm %lld steps", 
-                t["truth_stiffness_scale"].get<double>(), t["residual_rms_mps2"].get<double>(),
-                t["residual_max_mps2"].get<double>(), t["residual_alarm_steps"].get<long long>());
-    if (!t["first_residual_alarm_s"].is_null()) std::printf(" from %.2f s", t["first_residual_alarm_s"].get<double>());
-    std::printf(", drift alarm %lld steps\n", t["drift_alarm_steps"].get<long long>());
+  // Steps, deadlines and latency
+  std::printf("  steps %lld of %lld, deadline misses %lld (deadline %.3g ms)", r.steps, r.samples, r.deadline_misses,
+              1e3 * r.deadline_s);
+  if (r.latency_us)
+    std::printf(", latency mean %.0f us, p99 %.0f us, max %.0f us", r.latency_us->mean, r.latency_us->p99,
+                r.latency_us->max);
+  // Faults, by kind
+  std::printf("\n  faults injected %lld, detected %lld, survived %lld; node restarts %lld\n", r.faults_injected,
+              r.faults_detected, r.faults_survived, r.node_restarts);
+  for (const auto& [name, c] : r.faults)
+    std::printf("    %-10s injected %5lld  detected %5lld  survived %5lld\n", name.c_str(), c.injected, c.detected,
+                c.survived);
+  std::printf("  max deviation from offline %.3g m%s; outputs finite: %s\n", r.max_deviation_from_offline,
+              r.bit_exact ? " (bit for bit equal)" : "", r.outputs_finite ? "yes" : "NO");
+  // The modes
+  if (r.twin) {
+    const host::HilTwinReport& t = *r.twin;
+    std::printf("  twin: eta_k %.3g, residual RMS %.4g m/s^2 (max %.4g), residual alarm %lld steps",
+                t.truth_stiffness_scale, t.residual_rms_mps2, t.residual_max_mps2, t.residual_alarm_steps);
+    if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
+    std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
   }
-  if (j.contains("hybrid")) {
-    const auto& hy = j["hybrid"];
+  if (r.hybrid) {
+    const host::HilHybridReport& hy = *r.hybrid;
     std::printf("  hybrid: compensation %.2f ms (order %d): tracking RMS %.3g mm, peak %.3g mm; top floor vs pure "
                 "simulation RMS %.3g mm, peak %.3g mm (peaks %.4f / %.4f m)\n",
-                1e3 * hy["compensation_delay_s"].get<double>(), hy["compensation_order"].get<int>(),
-                1e3 * hy["tracking_rms_m"].get<double>(), 1e3 * hy["tracking_peak_m"].get<double>(),
-                1e3 * hy["top_diff_from_pure_rms_m"].get<double>(), 1e3 * hy["top_diff_from_pure_peak_m"].get<double>(),
-                hy["peak_top_hybrid_m"].get<double>(), hy["peak_top_pure_m"].get<double>());
+                1e3 * hy.compensation_delay_s, hy.compensation_order, 1e3 * hy.tracking_rms_m,
+                1e3 * hy.tracking_peak_m, 1e3 * hy.top_diff_from_pure_rms_m, 1e3 * hy.top_diff_from_pure_peak_m,
+                hy.peak_top_hybrid_m, hy.peak_top_pure_m);
   }
 }
 
 int hil(const HilArgs& a) {
   const host::Scene scene = host::load_scene(a.scene_path);
-  const nlohmann::json j = host::run_hil(scene, a.opt);
-  if (a.as_json) std::printf("%s\n", j.dump().c_str());
-  else print_hil(j);
-  return j["outputs_finite"].get<bool>() ? kOk : kRefused;
+  const host::HilReport r = host::run_hil(scene, a.opt);
+  if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
+  else print_hil(r);
+  return r.outputs_finite ? kOk : kRefused;
 }
 
 // What each fault option injects at the samples SPEC picks.
@@ -106,9 +106,15 @@ void add_hil(CLI::App& vines) {
       "(hybrid) modes.",
       "SPEC of a fault: a rate per sample from 0 to 1, or @K1,K2,... sample indices.", [a] { return hil(*a); });
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
-  cmd->add_option("--mode", opt.mode, "replay (default), twin (digital-twin monitor), hybrid (shake table)")
+  const std::vector<std::string> modes(std::begin(host::kHilModeNames), std::end(host::kHilModeNames));
+  cmd->add_option_function<std::string>(
+         "--mode",
+         [&opt, modes](const std::string& v) {
+           opt.mode = static_cast<host::HilMode>(std::find(modes.begin(), modes.end(), v) - modes.begin());
+         },
+         "replay (default), twin (digital-twin monitor), hybrid (shake table)")
       ->type_name("replay|twin|hybrid")
-      ->check(CLI::IsMember({"replay", "twin", "hybrid"}));
+      ->check(CLI::IsMember(modes));
   cmd->add_flag("--realtime,!--virtual-clock", opt.realtime,
                 "pace samples at the sensor rate on the wall clock; or (default) lock step, as fast as the link "
                 "allows (the node's clock is the samples' stamps)");

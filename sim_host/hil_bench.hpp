@@ -1,0 +1,31 @@
+// A bench ready to run: the options checked against the scene and their
+// defaults resolved, the node chosen, the record loaded, and the node's
+// configuration and model image built.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sim_host/hil_boards.hpp"
+#include "sim_host/hil_options.hpp"
+#include "sim_host/run.hpp"
+#include "sim_host/scene.hpp"
+#include "vines/link/config.hpp"
+
+namespace vines::host {
+
+struct Bench {
+  Scene scene;                   // --duration applied; a board's scalar
+  HilOptions opt;                // timeout, board image and compensation delay resolved
+  const Board* board = nullptr;  // a "qemu:TARGET" node's board
+  Excitation ex;
+  long long samples = 0;
+  double h = 0;                  // sensor period [s]
+  link::NodeConfig cfg;          // what the node is configured with
+  std::vector<std::uint8_t> image;  // its model image (none in hybrid mode)
+};
+
+// Throws std::runtime_error naming the input (scene, option, node).
+Bench make_bench(const Scene& scene, const HilOptions& opt);
+
+}  // namespace vines::host

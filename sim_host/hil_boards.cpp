@@ -1,0 +1,54 @@
+#include "sim_host/hil_boards.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+#include "sim_host/hil.hpp"
+
+namespace vines::host {
+namespace {
+
+constexpr Board kBoards[] = {{"cortex-m4f", "mps2-an386", Scalar::kFloat}, {"cortex-m7", "mps2-an500", Scalar::kDouble}};
+
+}  // namespace
+
+std::vector<std::string> node_names() {
+  std::vector<std::string> names = {"host"};
+  for (const Board& b : kBoards) names.push_back(std::string("qemu:") + b.target);
+  return names;
+}
+
+const Board* board_of(const std::string& node) {
+  for (const Board& b : kBoards)
+    if (node == std::string("qemu:") + b.target) return &b;
+  return nullptr;
+}
+
+std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) {
+  std::string dev;
+  const DeviceParams& d = sc.params.device;
+  if (d.kind == DeviceKind::kNone) dev = "none";
+  else if (d.kind == DeviceKind::kTmd) dev = "tmd";
+  else if (d.vines.law == ContactLaw::kKuwabara) dev = "vines";
+  else
+    throw std::runtime_error(sc.path + ": --node " + opt.node +
+                             ": the board images run the bare frame, the TMD and the VI NES with the Kuwabara law");
+  if (sc.params.frame.stories != 10)
+    throw std::runtime_error(sc.path + ": --node " + opt.node + ": the board images are built for 10 stories");
+  const std::string path = !opt.image.empty() ? opt.image
+                                              : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +
+                                                    "/firmware/app/vines_node_" + dev + ".elf";
+  std::ifstream f(path);
+  if (!f)
+    throw std::runtime_error("--node " + opt.node + ": no board image " + path + " (build it: cmake --preset " +
+                             b.target + " && cmake --build --preset " + b.target + ")");
+  return path;
+}
+
+std::vector<std::string> qemu_argv(const Board& b, const std::string& image) {
+  return {"qemu-system-arm", "-M", b.machine, "-display", "none", "-monitor", "none",
+          "-semihosting-config", "enable=on,target=native", "-serial", "stdio",
+          "-icount", "shift=" + std::to_string(kIcountShift) + ",align=off,sleep=off", "-kernel", image};
+}
+
+}  // namespace vines::host

@@ -1,0 +1,138 @@
+#include "sim_host/hil_modes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+
+#include "sim_host/build_engine.hpp"
+#include "sim_host/hil_lab.hpp"
+#include "sim_host/hil_offline.hpp"
+
+namespace vines::host {
+namespace {
+
+using link::Telemetry;
+
+// Replay: the node's plant is the scene; nothing to add.
+class ReplayMode : public BenchMode {};
+
+// Twin: the node's twin (the nominal model) is fed the top-floor acceleration
+// of the measured building (stiffness scaled by eta_k, sensor noise added).
+class TwinMode : public BenchMode {
+ public:
+  explicit TwinMode(const Bench& b) : b_(b) {
+    link::NodeConfig truth = b.cfg;
+    truth.mode = link::NodeMode::kReplay;
+    truth.scene.frame.stiffness_scale *= b.opt.truth_stiffness_scale;
+    const std::vector<Telemetry> t = offline_run(truth, b.ex.samples, "--truth-stiffness-scale");
+    std::mt19937_64 rng(b.opt.seed + 17);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    for (const Telemetry& r : t) measured_.push_back(r.acc_top + b.opt.measure_noise_mps2 * noise(rng));
+  }
+
+  double aux(long long k, const HilRecord&) const override { return measured_[static_cast<std::size_t>(k)]; }
+
+  // The residual the twin reports, its alarms and the drift alarms' stories.
+  void report(const HilRecord& rec, const std::vector<Telemetry>&, HilReport* r) const override {
+    HilTwinReport tw;
+    double ss = 0;
+    long long used = 0;
+    std::uint64_t stories = 0;
+    for (long long k = 0; k < rec.samples; ++k) {
+      if (!rec.got[k]) continue;
+      const Telemetry& t = rec.tel[k];
+      if (!(t.flags & link::kAuxMissing))
+        ss += t.aux * t.aux, ++used, tw.residual_max_mps2 = std::max(tw.residual_max_mps2, std::fabs(t.aux));
+      if (t.flags & link::kResidualAlarm) {
+        ++tw.residual_alarm_steps;
+        if (!tw.first_residual_alarm_s) tw.first_residual_alarm_s = static_cast<double>(k) * b_.h;
+      }
+      if (t.flags & link::kDriftAlarm) {
+        ++tw.drift_alarm_steps;
+        stories |= t.drift_alarms;
+        if (!tw.first_drift_alarm_s) tw.first_drift_alarm_s = static_cast<double>(k) * b_.h;
+      }
+    }
+    for (int i = 0; i < b_.scene.params.frame.stories; ++i)
+      if (stories >> i & 1) tw.stories_alarmed.push_back(i + 1);
+    tw.truth_stiffness_scale = b_.opt.truth_stiffness_scale;
+    tw.residual_rms_mps2 = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
+    tw.residual_limit_mps2 = b_.opt.residual_limit_mps2;
+    tw.drift_limit_m = b_.opt.drift_limit_m;
+    r->twin = tw;
+  }
+
+ private:
+  const Bench& b_;
+  std::vector<double> measured_;  // the measured building's top-floor acceleration
+};
+
+// Hybrid: the node's bare frame commands the table (its top floor's motion);
+// the lab moves the table with the VI NES on it, and the load cell's force
+// goes back to the node.
+class HybridMode : public BenchMode {
+ public:
+  HybridMode(const Bench& b, const Telemetry& initial) : b_(b) {
+    const Scene& sc = b.scene;
+    const std::unique_ptr<Engine> eng = build_engine(sc.params, sc.scalar, sc.path);
+    const HilOptions& o = b.opt;
+    const LabOptions lo{o.actuator_hz, o.actuator_zeta, o.actuator_delay_s, o.force_noise_n, o.force_lsb_n, o.seed};
+    lab_ = std::make_unique<ShakeTable>(eng->info().vines, sc.params.device.vines.law, initial.particle_x,
+                                        initial.particle_v, b.h, lo);
+  }
+
+  // The table follows the last command received; the load cell reads the
+  // specimen at the sample instant.
+  void drive(long long k, HilRecord* rec) override {
+    const std::vector<double>& a = b_.ex.samples;
+    rec->force[k] = k == 0 ? 0.0 : lab_->advance(last_command_, a[k - 1], a[k]);
+    rec->table_x[k] = lab_->table_x();
+  }
+  double aux(long long k, const HilRecord& rec) const override { return rec.force[k]; }
+  void on_telemetry(const Telemetry& t) override { last_command_ = t.aux; }
+
+  // Tracking: desired table motion (the frame's top floor) against the
+  // table's measured motion; the top floor against the pure simulation.
+  void report(const HilRecord& rec, const std::vector<Telemetry>& offline, HilReport* r) const override {
+    const HilOptions& o = b_.opt;
+    HilHybridReport hy;
+    const int n = b_.scene.params.frame.stories;
+    double ss = 0, dss = 0;
+    long long used = 0;
+    for (long long k = 0; k < rec.samples; ++k) {
+      if (!rec.got[k]) continue;
+      const Telemetry& t = rec.tel[k];
+      const double err = t.x[n - 1] - rec.table_x[k];
+      ss += err * err, hy.tracking_peak_m = std::max(hy.tracking_peak_m, std::fabs(err)), ++used;
+      const double d = t.x[n - 1] - offline[k].x[n - 1];
+      dss += d * d, hy.top_diff_from_pure_peak_m = std::max(hy.top_diff_from_pure_peak_m, std::fabs(d));
+      hy.peak_top_hybrid_m = std::max(hy.peak_top_hybrid_m, std::fabs(t.x[n - 1]));
+      hy.peak_top_pure_m = std::max(hy.peak_top_pure_m, std::fabs(offline[k].x[n - 1]));
+    }
+    hy.actuator_hz = o.actuator_hz, hy.actuator_zeta = o.actuator_zeta, hy.actuator_delay_s = o.actuator_delay_s;
+    hy.compensation_delay_s = o.comp_delay_s;
+    hy.compensation_order = o.comp_order;
+    hy.force_noise_n = o.force_noise_n, hy.force_lsb_n = o.force_lsb_n;
+    hy.tracking_rms_m = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
+    hy.top_diff_from_pure_rms_m = used ? std::sqrt(dss / static_cast<double>(used)) : 0.0;
+    r->hybrid = hy;
+  }
+
+ private:
+  const Bench& b_;
+  std::unique_ptr<ShakeTable> lab_;
+  double last_command_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<BenchMode> make_mode(const Bench& b, const std::vector<Telemetry>& offline) {
+  switch (b.opt.mode) {
+    case HilMode::kTwin: return std::make_unique<TwinMode>(b);
+    case HilMode::kHybrid: return std::make_unique<HybridMode>(b, offline[0]);
+    default: return std::make_unique<ReplayMode>();
+  }
+}
+
+}  // namespace vines::host

@@ -1,0 +1,24 @@
+// What the bench computes in its own process: the model image it sends the
+// node, and the offline run the node's telemetry is compared with.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vines/link/config.hpp"
+#include "vines/link/messages.hpp"
+
+namespace vines::host {
+
+// The model image of a node's configuration (model_image.hpp): what the
+// bench sends so that no node builds a model. Hybrid nodes build the bare
+// frame themselves (host only) and get none. Errors name `what`.
+std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what);
+
+// The offline run: the scene's engine stepped in this process, read exactly
+// as the node reads it (HostPlant), so equal code gives equal bits.
+std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
+                                         const std::string& what);
+
+}  // namespace vines::host

@@ -1,0 +1,66 @@
+// What `vines hil` is asked to do: the mode, the clock, the node, the faults
+// to inject and each mode's settings (the command line fills them in
+// sim_host/cli/hil.cpp; run_hil in hil.hpp runs them).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vines::host {
+
+// When a fault is injected: with a probability per sample, or at samples.
+struct FaultSpec {
+  double rate = 0;
+  std::vector<long long> at;
+  bool any() const { return rate > 0 || !at.empty(); }
+};
+
+enum class FaultKind { kDrop, kCorrupt, kDuplicate, kReorder, kLate, kNonFinite, kSaturate, kStall, kRestart, kCount };
+inline constexpr int kFaultKinds = static_cast<int>(FaultKind::kCount);
+const char* fault_kind_name(FaultKind k);
+
+// Parses a fault spec: "RATE" (0..1) or "@K1,K2,..."; throws naming the option.
+FaultSpec parse_fault_spec(const std::string& option, const std::string& value);
+
+// The bench's modes: replay (the scene as `vines run` runs it), twin
+// (digital-twin monitor against a bench truth model), hybrid (shake table).
+enum class HilMode { kReplay, kTwin, kHybrid };
+// Their names (--mode, the report), in the enum's order.
+inline constexpr const char* kHilModeNames[] = {"replay", "twin", "hybrid"};
+inline const char* hil_mode_name(HilMode m) { return kHilModeNames[static_cast<int>(m)]; }
+
+struct HilOptions {
+  HilMode mode = HilMode::kReplay;
+  bool realtime = false;
+  double duration_s = 0;        // 0: the scene's
+  std::string csv;              // "" : none
+  double timeout_s = 0;         // longest wait for the node (0: 5 s, 60 s for a board in QEMU)
+  double deadline_periods = 1;  // telemetry k due by (k + this) h
+  unsigned long long seed = 1;
+  FaultSpec faults[kFaultKinds];
+  int late_periods = 3, stall_periods = 20;
+  double saturate_g = 0;        // sensor range (0: none)
+  // node fault policy
+  double grace_periods = 1.5, node_stall_periods = 10;
+  // twin
+  double truth_stiffness_scale = 1;  // the bench's building (eta_k)
+  double measure_noise_mps2 = 0;
+  double drift_limit_m = 0;          // every story (0: no alarm)
+  double residual_limit_mps2 = 0.05;
+  double residual_window_s = 1.0;
+  // hybrid
+  double actuator_hz = 20, actuator_zeta = 0.7, actuator_delay_s = 0.005;
+  double force_noise_n = 50, force_lsb_n = 10;
+  double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
+  int comp_order = 2;
+  // The node: "host" (this program's `vines node`), "qemu:cortex-m4f" or
+  // "qemu:cortex-m7" (the board image in QEMU, instructions counted), or the
+  // path of a program that speaks the link on stdin/stdout.
+  std::string node = "host";
+  std::string node_command;       // host node: the program run as `PROGRAM node` ("" : this one)
+  std::string image;              // qemu: the board image ("" : the preset build's)
+  std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
+};
+
+}  // namespace vines::host

@@ -1,0 +1,135 @@
+#include "sim_host/hil_report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+#include "sim_host/hil_record.hpp"
+
+namespace vines::host {
+namespace {
+
+using nlohmann::json;
+
+json to_json(const std::optional<HilStats>& s) {
+  if (!s) return nullptr;
+  return {{"mean", s->mean}, {"p50", s->p50}, {"p99", s->p99}, {"max", s->max}};
+}
+
+json to_json(const std::optional<double>& x) { return x ? json(*x) : json(nullptr); }
+
+json to_json(const HilTwinReport& t) {
+  return {{"truth_stiffness_scale", t.truth_stiffness_scale},
+          {"residual_rms_mps2", t.residual_rms_mps2},
+          {"residual_max_mps2", t.residual_max_mps2},
+          {"residual_limit_mps2", t.residual_limit_mps2},
+          {"residual_alarm_steps", t.residual_alarm_steps},
+          {"first_residual_alarm_s", to_json(t.first_residual_alarm_s)},
+          {"drift_limit_m", t.drift_limit_m},
+          {"drift_alarm_steps", t.drift_alarm_steps},
+          {"first_drift_alarm_s", to_json(t.first_drift_alarm_s)},
+          {"stories_alarmed", t.stories_alarmed}};
+}
+
+json to_json(const HilHybridReport& h) {
+  return {{"actuator", {{"hz", h.actuator_hz}, {"zeta", h.actuator_zeta}, {"delay_s", h.actuator_delay_s}}},
+          {"compensation_delay_s", h.compensation_delay_s},
+          {"compensation_order", h.compensation_order},
+          {"force_noise_n", h.force_noise_n},
+          {"force_lsb_n", h.force_lsb_n},
+          {"tracking_rms_m", h.tracking_rms_m},
+          {"tracking_peak_m", h.tracking_peak_m},
+          {"top_diff_from_pure_rms_m", h.top_diff_from_pure_rms_m},
+          {"top_diff_from_pure_peak_m", h.top_diff_from_pure_peak_m},
+          {"peak_top_hybrid_m", h.peak_top_hybrid_m},
+          {"peak_top_pure_m", h.peak_top_pure_m}};
+}
+
+}  // namespace
+
+json to_json(const HilReport& r) {
+  json j;
+  // The run
+  j["scene"] = r.scene;
+  j["mode"] = hil_mode_name(r.mode);
+  j["clock"] = r.realtime ? "realtime" : "virtual";
+  j["scalar"] = scalar_name(r.scalar);
+  j["sensor_rate_hz"] = r.sensor_rate_hz;
+  // Steps and deadlines
+  j["samples"] = r.samples;
+  j["steps"] = r.steps;
+  j["missing_steps"] = r.missing_steps;
+  j["deadline_s"] = r.deadline_s;
+  j["deadline_misses"] = r.deadline_misses;
+  j["latency_us"] = to_json(r.latency_us);
+  // Faults
+  j["faults_injected"] = r.faults_injected;
+  j["faults_detected"] = r.faults_detected;
+  j["faults_survived"] = r.faults_survived;
+  j["faults"] = json::object();
+  for (const auto& [name, c] : r.faults)
+    j["faults"][name] = {{"injected", c.injected}, {"detected", c.detected}, {"survived", c.survived}};
+  j["node_faults"] = json::object();
+  for (const auto& [name, count] : r.node_faults) j["node_faults"][name] = count;
+  j["node_restarts"] = r.node_restarts;
+  j["bad_frames_from_node"] = r.bad_frames_from_node;
+  // Against the offline run
+  j["max_deviation_from_offline"] = r.max_deviation_from_offline;
+  j["bit_exact"] = r.bit_exact;
+  j["outputs_finite"] = r.outputs_finite;
+  j["max_abs_floor_displacement_m"] = r.max_abs_floor_displacement_m;
+  // The node
+  j["node_status"] = {{"steps", r.node_status.steps}, {"state", r.node_status.state},
+                      {"exit_status", r.node_status.exit_status}};
+  const link::StepTiming& tm = r.node_deadline;
+  j["node"] = r.node;
+  j["node_deadline"] = {{"counter_hz", tm.counter_hz},   {"budget_ticks", tm.budget_ticks},
+                        {"overruns", tm.overruns},       {"worst_ticks", tm.worst_ticks},
+                        {"worst_k", tm.worst_k},         {"stack_peak_bytes", tm.stack_peak_bytes}};
+  j["step_ticks"] = to_json(r.step_ticks);
+  j["steps_over_budget"] = r.steps_over_budget;
+  if (r.board) {
+    j["icount_shift"] = r.board->icount_shift;
+    j["worst_step_instructions"] = r.board->worst_step_instructions;
+    j["worst_step_k"] = r.board->worst_step_k;
+    j["median_step_instructions"] = r.board->median_step_instructions;
+  }
+  j["wall_time_s"] = r.wall_time_s;
+  // The modes
+  if (r.twin) j["twin"] = to_json(*r.twin);
+  if (r.hybrid) j["hybrid"] = to_json(*r.hybrid);
+  return j;
+}
+
+void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
+                   int stories, double h) {
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("--csv " + path + ": cannot write");
+  const bool hybrid = !rec.table_x.empty();
+  const int n = stories;
+  // Header, then one row per sample (a sample without telemetry: zeros).
+  f << "k,t_s,ag_sent_mps2,ag_used_mps2,received,flags,latency_us,x_top_m,x_top_offline_m,deviation_m,acc_top_mps2,"
+       "Ee_Js,particle_x_m,contact_force_n,dissipated_J,aux,drift_alarms";
+  if (hybrid) f << ",table_x_m,force_measured_n";
+  f << '\n';
+  char buf[512];
+  for (long long k = 0; k < rec.samples; ++k) {
+    const link::Telemetry& t = rec.tel[k];
+    const bool got = rec.got[k];
+    std::snprintf(buf, sizeof buf, "%lld,%.6f,%.17g,%.17g,%d,%u,%.1f,%.17g,%.17g,%.3g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%llu",
+                  k, static_cast<double>(k) * h, rec.sensed[k], t.ag, got ? 1 : 0, t.flags,
+                  got ? 1e6 * (rec.arrival[k] - rec.handled[k]) : 0.0, t.x[n - 1], offline[k].x[n - 1],
+                  got ? std::fabs(t.x[n - 1] - offline[k].x[n - 1]) : 0.0, t.acc_top, t.elastic_energy,
+                  t.particle_x, t.contact_force, t.dissipated, t.aux,
+                  static_cast<unsigned long long>(t.drift_alarms));
+    f << buf;
+    if (hybrid) {
+      std::snprintf(buf, sizeof buf, ",%.17g,%.17g", rec.table_x[k], rec.force[k]);
+      f << buf;
+    }
+    f << '\n';
+  }
+}
+
+}  // namespace vines::host

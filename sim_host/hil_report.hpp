@@ -1,0 +1,113 @@
+// The report of a `vines hil` run as typed structs: what the bench measured
+// (steps, deadlines, latency, faults, deviation from the offline run), the
+// node's own deadline monitor, and each mode's results. to_json gives the
+// report `vines hil --json` prints; write_hil_csv the per-step rows of --csv.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sim_host/hil_options.hpp"
+#include "sim_host/scalar.hpp"
+#include "vines/link/messages.hpp"
+
+namespace vines::host {
+
+struct HilRecord;
+
+// Mean and quantiles of a set of values.
+struct HilStats {
+  double mean = 0, p50 = 0, p99 = 0, max = 0;
+};
+
+// Faults of one kind: how many were injected, detected by the node, survived.
+struct HilFaultCounts {
+  long long injected = 0, detected = 0, survived = 0;
+};
+
+// The node's last status: steps taken, state, and how its process ended.
+struct HilNodeStatus {
+  std::uint32_t steps = 0;
+  int state = 0;        // link::NodeState
+  int exit_status = 0;  // its process's (128 + signal if killed)
+};
+
+// A board in QEMU: its steps' cost in instructions (-icount counts them).
+struct HilBoardSteps {
+  int icount_shift = 0;
+  double worst_step_instructions = 0;
+  std::uint32_t worst_step_k = 0;
+  double median_step_instructions = 0;
+};
+
+// Twin mode: the residual of the twin against the measured building, alarms.
+struct HilTwinReport {
+  double truth_stiffness_scale = 1;
+  double residual_rms_mps2 = 0, residual_max_mps2 = 0, residual_limit_mps2 = 0;
+  long long residual_alarm_steps = 0;
+  std::optional<double> first_residual_alarm_s;
+  double drift_limit_m = 0;
+  long long drift_alarm_steps = 0;
+  std::optional<double> first_drift_alarm_s;
+  std::vector<int> stories_alarmed;  // from 1
+};
+
+// Hybrid mode: the actuator, its compensation, the tracking of the table and
+// the top floor against the pure simulation.
+struct HilHybridReport {
+  double actuator_hz = 0, actuator_zeta = 0, actuator_delay_s = 0;
+  double compensation_delay_s = 0;
+  int compensation_order = 0;
+  double force_noise_n = 0, force_lsb_n = 0;
+  double tracking_rms_m = 0, tracking_peak_m = 0;
+  double top_diff_from_pure_rms_m = 0, top_diff_from_pure_peak_m = 0;
+  double peak_top_hybrid_m = 0, peak_top_pure_m = 0;
+};
+
+struct HilReport {
+  std::string scene;
+  HilMode mode = HilMode::kReplay;
+  bool realtime = false;
+  Scalar scalar = Scalar::kDouble;
+  double sensor_rate_hz = 0;
+  // Steps and deadlines
+  long long samples = 0, steps = 0, missing_steps = 0;
+  double deadline_s = 0;
+  long long deadline_misses = 0;
+  std::optional<HilStats> latency_us;  // none without a step
+  // Faults: injected by the bench (by kind), counted by the node (by code)
+  long long faults_injected = 0, faults_detected = 0, faults_survived = 0;
+  std::map<std::string, HilFaultCounts> faults;
+  std::map<std::string, long long> node_faults;
+  long long node_restarts = 0, bad_frames_from_node = 0;
+  // Against the offline run
+  double max_deviation_from_offline = 0;
+  bool bit_exact = false, outputs_finite = true;
+  double max_abs_floor_displacement_m = 0;
+  // The node: status, its deadline monitor and its steps' cost from telemetry
+  HilNodeStatus node_status;
+  std::string node;
+  link::StepTiming node_deadline;
+  std::optional<HilStats> step_ticks;
+  long long steps_over_budget = 0;  // from telemetry: equals the monitor's overruns on a clean run
+  std::optional<HilBoardSteps> board;
+  double wall_time_s = 0;
+  // The modes' own results
+  std::optional<HilTwinReport> twin;
+  std::optional<HilHybridReport> hybrid;
+};
+
+// The report as `vines hil --json` prints it.
+nlohmann::json to_json(const HilReport& r);
+
+// Writes --csv: one row per sample (hybrid: with the table and the load cell).
+// Throws naming the file if it cannot be written.
+void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
+                   int stories, double h);
+
+}  // namespace vines::host

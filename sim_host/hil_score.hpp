@@ -1,0 +1,21 @@
+// Scoring a `vines hil` run: each planned fault detected by the node and
+// survived (and the clipped samples), deadlines and latency, the deviation
+// from the offline run, the node's fault counts and its deadline monitor.
+#pragma once
+
+#include <vector>
+
+#include "sim_host/hil_bench.hpp"
+#include "sim_host/hil_faults.hpp"
+#include "sim_host/hil_record.hpp"
+#include "sim_host/hil_report.hpp"
+#include "vines/link/messages.hpp"
+
+namespace vines::host {
+
+// The report of a run but the modes' parts (hil_modes.hpp); marks each event
+// detected and survived.
+HilReport score(const Bench& b, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
+                std::vector<FaultEvent>* events);
+
+}  // namespace vines::host
