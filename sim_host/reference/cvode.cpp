@@ -123,8 +123,8 @@ class CvodeRun {
   void set_roots() {
     int dir[3] = {0, 1, 1};
     int n = 1;
-    if (ode_.has_particle()) n = mode_ == Mode::kStuckLeft || mode_ == Mode::kStuckRight ? 2 : 3;
-    if (mode_ == Mode::kContactLeft || mode_ == Mode::kContactRight) dir[2] = -1;
+    if (ode_.has_particle()) n = riding(mode_) ? 2 : 3;
+    if (in_contact(mode_)) dir[2] = -1;
     check(CVodeRootInit(mem_, n, &CvodeRun::roots), "CVodeRootInit");
     check(CVodeSetRootDirection(mem_, dir), "CVodeSetRootDirection");
   }
@@ -145,38 +145,13 @@ class CvodeRun {
     check(CVodeGetRootInfo(mem_, found), "CVodeGetRootInfo");
     double* y = NV_DATA_S(y_);
     ++tally_.r.events;
-    const bool contact = mode_ == Mode::kContactLeft || mode_ == Mode::kContactRight;
-    if (contact && found[2]) tally_.overlap(ode_.overlap(y, side()));
+    if (in_contact(mode_) && found[2]) tally_.overlap(ode_.overlap(y, side()));
     if (!ode_.has_particle()) return;
     int s = found[1] ? side() : 0;  // the wall of a mode event
     if (mode_ == Mode::kFree) s = found[1] ? -1 : found[2] ? 1 : 0;
     if (!s) return;
     const Mode before = mode_;
-    switch (mode_) {
-      case Mode::kFree: {
-        if (ode_.restitution()) {
-          const double v_app = ode_.overlap_rate(y, s);
-          if (!(v_app > 0.0)) return;
-          tally_.impact(t, v_app);
-          if (ode_.impact(y, s, v_app)) {
-            mode_ = s < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
-            if ((s < 0 ? -ode_.holding_force(y) : ode_.holding_force(y)) > 0.0) mode_ = Mode::kFree;
-          }
-        } else {
-          mode_ = s < 0 ? Mode::kContactLeft : Mode::kContactRight;
-          tally_.begin_contact(t);
-        }
-        break;
-      }
-      case Mode::kContactLeft:
-      case Mode::kContactRight:
-        tally_.end_contact(ode_.spec().count_depth);
-        mode_ = Mode::kFree;
-        break;
-      default:
-        mode_ = Mode::kFree;
-        break;
-    }
+    if (!take_event(mode_, s, ode_, y, tally_, t)) return;
     // New smooth piece (or a velocity jump): restart CVODE here.
     collect();
     check(CVodeReInit(mem_, t, y_), "CVodeReInit");

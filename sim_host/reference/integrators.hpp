@@ -1,13 +1,16 @@
 // Internals shared by the reference and CVODE integrators: the ground input,
-// the bookkeeping of peaks and contacts, the two drivers.
+// the bookkeeping of peaks and contacts, what an event does (the firmware's
+// contact-mode state machine), the two drivers.
 #pragma once
 
 #include <cmath>
 #include <utility>
 #include <vector>
 
+#include "sim_host/reference/ode.hpp"
 #include "sim_host/reference/spec.hpp"
 #include "sim_host/reference/truth.hpp"
+#include "vines/contact_mode.hpp"
 
 namespace vines::host::reference {
 
@@ -39,9 +42,43 @@ struct Tally {
   }
   // An instantaneous impact: counted unless it is a plastic landing at rest.
   void impact(double t, double v_app) {
-    if (v_app > 1e-6) ++r.contacts, r.contact_start_s.push_back(t);
+    if (v_app > kStickSpeed) ++r.contacts, r.contact_start_s.push_back(t);
   }
 };
+
+// What the contact-mode transitions (contact_mode.hpp) do in both drivers
+// at an event at time t on the state y: Newton's impact law applied and
+// tallied, a contact's start and end tallied.
+template <typename T>
+struct EventActs {
+  const SceneOde<T>& ode;
+  T* y;
+  Tally& tally;
+  double t;
+
+  Impact impact(int side) {
+    const T v_app = ode.overlap_rate(y, side);
+    if (!(v_app > T(0))) return Impact::kNone;
+    const bool plastic = ode.impact(y, side, v_app);
+    tally.impact(t, static_cast<double>(v_app));
+    return plastic ? Impact::kPlastic : Impact::kRebound;
+  }
+  // Riding wall `side`, the wall would have to pull.
+  bool pulls(int side) const { return (side < 0 ? -ode.holding_force(y) : ode.holding_force(y)) > T(0); }
+  void begin_contact(int) { tally.begin_contact(t); }
+  bool end_contact() {
+    tally.end_contact(ode.spec().count_depth);
+    return true;
+  }
+};
+
+// The transition at an event on wall `side` (-1, +1) from the driver's mode;
+// false if there was none after all (an impact without approach).
+template <typename T>
+bool take_event(Mode& mode, int side, const SceneOde<T>& ode, T* y, Tally& tally, double t) {
+  EventActs<T> act{ode, y, tally, t};
+  return vines::take_event(mode, side, ode.restitution(), act);
+}
 
 Result integrate_reference(const OdeSpec& spec, const Ground& g, double rtol);
 Result integrate_cvode(const OdeSpec& spec, const Ground& g, double rtol, bool bdf);

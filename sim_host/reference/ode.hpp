@@ -5,7 +5,8 @@
 // displacement w from where it starts (walls at r = w - x_floor equal to
 // wall_left, wall_right). E_e = integral of (1/2) x^T K_frame x dt.
 // Every mass carries -m a_g. The smooth pieces are the modes below; the
-// integrators switch between them at located events.
+// integrators switch between them at located events, by the firmware's
+// contact-mode state machine (take_event in integrators.hpp).
 #pragma once
 
 #include <algorithm>
@@ -15,14 +16,15 @@
 
 #include "sim_host/reference/spec.hpp"
 #include "vines/contact.hpp"
+#include "vines/contact_mode.hpp"
 
 namespace vines::host::reference {
 
-enum class Mode { kFree, kContactLeft, kContactRight, kStuckLeft, kStuckRight };
-
-// Below this approach speed [m/s] an instantaneous impact is plastic and the
-// particle rides the wall (the firmware's rule, substep.hpp kStickSpeed).
-inline constexpr double kStickSpeed = 1e-6;
+// The particle's modes and the plastic-impact speed are the firmware's
+// (contact_mode.hpp): below kStickSpeed an instantaneous impact is plastic
+// and the particle rides the wall.
+using vines::kStickSpeed;
+using vines::Mode;
 
 template <typename T>
 class SceneOde {

@@ -162,7 +162,7 @@ class ReferenceRun {
                const T xl = std::fabs(ode_.top_x(b.ylo.data())), xh = std::fabs(ode_.top_x(b.yhi.data()));
                tally_.peak(static_cast<double>(std::max(xl, xh)), time(s0_ + (xl > xh ? b.lo : b.hi)));
              });
-    if (mode_ != Mode::kContactLeft && mode_ != Mode::kContactRight) return;
+    if (!in_contact(mode_)) return;
     const int side = mode_ == Mode::kContactLeft ? -1 : 1;
     const int p = ode_.size() / 2, fl = ode_.spec().floor, n = ode_.floors();
     tally_.overlap(static_cast<double>(ode_.overlap(ye.data(), side)));
@@ -174,35 +174,8 @@ class ReferenceRun {
              });
   }
 
-  // ---- what an event does ----
-  void apply(int side) {
-    const double t = time(s0_);
-    switch (mode_) {
-      case Mode::kFree:
-        if (ode_.restitution()) {
-          const T v_app = ode_.overlap_rate(y_.data(), side);
-          if (!(v_app > T(0))) return;
-          const bool plastic = ode_.impact(y_.data(), side, v_app);
-          tally_.impact(t, static_cast<double>(v_app));
-          if (plastic) {
-            mode_ = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
-            if (event_g(y_.data(), side) > T(0)) mode_ = Mode::kFree;  // the wall would pull: fly on
-          }
-        } else {
-          mode_ = side < 0 ? Mode::kContactLeft : Mode::kContactRight;
-          tally_.begin_contact(t);
-        }
-        break;
-      case Mode::kContactLeft:
-      case Mode::kContactRight:
-        tally_.end_contact(ode_.spec().count_depth);
-        mode_ = Mode::kFree;
-        break;
-      default:
-        mode_ = Mode::kFree;
-        break;
-    }
-  }
+  // ---- what an event does: the firmware's contact-mode transition ----
+  void apply(int side) { take_event(mode_, side, ode_, y_.data(), tally_, time(s0_)); }
 
   // An event due before any time passes (the state already beyond a surface,
   // and approaching it in free flight): 0 if none, else the wall side.

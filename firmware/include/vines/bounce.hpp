@@ -1,6 +1,7 @@
 // A sphere hitting a fixed rigid wall (paper Fig. 2): the reference problem
 // behind the contact laws. Integrated in double with adaptive Dormand-Prince
-// steps and the contact end located to rounding; used to calibrate the
+// steps (the sub-steppers' step-size control, step_control.hpp) and the
+// contact end located to rounding; used to calibrate the
 // Kuwabara relaxation time tau from (eps, v_ref) and by the tests.
 #pragma once
 
@@ -11,6 +12,7 @@
 #include "vines/contact.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
+#include "vines/step_control.hpp"
 
 namespace vines {
 
@@ -52,7 +54,7 @@ BounceResult bounce(const Law& law, double m, double v, double rtol = 1e-13) {
     const auto r = numeric::dopri5_step<Vec>(rhs, t, y, f, h);
     const double en = err_norm(r.err, y, r.y);
     if (en > 1.0) {
-      h *= std::fmax(0.1, 0.9 * std::pow(en, -0.2));
+      h *= numeric::shrink_factor(en);
       continue;
     }
     ++out.steps;
@@ -80,7 +82,7 @@ BounceResult bounce(const Law& law, double m, double v, double rtol = 1e-13) {
     t += h;
     y = r.y;
     f = r.f;
-    h *= std::fmin(5.0, std::fmax(0.2, 0.9 * std::pow(std::fmax(en, 1e-10), -0.2)));
+    h *= numeric::grow_factor(en);
   }
   return out;
 }

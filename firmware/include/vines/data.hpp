@@ -6,18 +6,10 @@
 
 #include <Eigen/Core>
 
+#include "vines/contact_mode.hpp"
 #include "vines/model.hpp"
 
 namespace vines {
-
-// Where the particle is with respect to the walls.
-enum class Mode : std::uint8_t {
-  kFree,
-  kContactLeft,   // finite-duration contact with the left wall
-  kContactRight,
-  kStuckLeft,     // instantaneous law: riding the wall at zero relative speed
-  kStuckRight,
-};
 
 // Energy ledger [J], accumulated in double whatever the loop's scalar.
 struct Ledger {

@@ -20,36 +20,22 @@
 
 #include <Eigen/Core>
 
+#include "vines/contact_mode.hpp"
 #include "vines/data.hpp"
+#include "vines/events.hpp"
 #include "vines/model.hpp"
 #include "vines/numeric/dopri5.hpp"
-#include "vines/numeric/hermite.hpp"
 #include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
 #include "vines/peaks.hpp"
+#include "vines/step_control.hpp"
 
 namespace vines {
-
-// Below this approach speed [m/s] an instantaneous impact is taken as plastic
-// and the particle rides the wall (no Zeno cascade of ever smaller bounces);
-// impacts slower than it are not counted. The threshold also rises to the
-// speed whose rebound, against the acceleration that pushes the particle
-// into the wall, would not lift it by the contact counting depth: such
-// bounces are below what the model resolves, and a cascade of them would be
-// resolved one by one (hundreds of thousands of impacts).
-inline constexpr double kStickSpeed = 1e-6;
-
-// Overlap with the left and right walls for a relative position r = s - x_f
-// (positive means interpenetration).
-template <typename S, typename DM>
-S overlap_left(const DM& dm, S r) { return dm.wall_left - r; }
-template <typename S, typename DM>
-S overlap_right(const DM& dm, S r) { return r - dm.wall_right; }
 
 // Elastic energy stored in the current contact, (2/5) C d^{5/2}.
 template <typename S, int N, typename Dev>
 S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
-  if (d.mode != Mode::kContactLeft && d.mode != Mode::kContactRight) return S(0);
+  if (!in_contact(d.mode)) return S(0);
   const S r = d.s - m.dev_x(d.z);
   const S dl = d.mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
   return dl > S(0) ? S(0.4) * m.dev.c * dl * dl * std::sqrt(dl) : S(0);
@@ -95,7 +81,7 @@ struct SubStepper {
 
   S ag(S t) const { return a0 + al * t; }
   // In a contact the independent variable is w (dt/dw = 4 q^3), else t.
-  bool regular() const { return mode == Mode::kContactLeft || mode == Mode::kContactRight; }
+  bool regular() const { return in_contact(mode); }
   S rel_pos(const Vec& y) const { return y(NX) - m.dev_x(y.template head<NX>()); }
   S rel_vel(const Vec& y) const { return y(NX + 1) - m.dev_v(y.template head<NX>()); }
 
@@ -117,7 +103,7 @@ struct SubStepper {
         *loss = f.dissipative * ddl;
         if (rate) *rate = ddl;
       }
-    } else if (mode == Mode::kStuckLeft || mode == Mode::kStuckRight) {
+    } else if (riding(mode)) {
       // Riding the wall: the force that gives the particle the floor's
       // acceleration, m* (floor acceleration without the device + a_g).
       const S a = ag(y(kT));
@@ -201,7 +187,7 @@ void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, con
   if (floors && m.loop.floor_peaks)
     detail::update_peaks<S, N>(m.floor_x(z0), m.floor_v(z0), m.floor_x(z1), m.floor_v(z1), h, d.peak_x,
                                d.peak_drift);
-  if (mode == Mode::kContactLeft || mode == Mode::kContactRight) {
+  if (in_contact(mode)) {
     const S r = y1(NX) - m.dev_x(z1);
     const S dl = mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
     if (dl > d.contact_depth) d.contact_depth = dl;
@@ -209,77 +195,102 @@ void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, con
   }
 }
 
-// What happens at a located event (side: -1 left wall, +1 right wall). A
-// contact ends where q reaches zero if the walls overlap by no more than
-// end_tol there (else q goes back on the overlap, below).
+namespace detail {
+
+// What the contact-mode transitions (take_event, contact_mode.hpp) do to a
+// sub-stepper's state y: impacts of the instantaneous law, q at a contact's
+// start, the contact counted at its end. A contact ends where q reaches zero
+// if the walls overlap by no more than end_tol there (else q goes back on the
+// overlap and the contact goes on).
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side, S end_tol) {
-  constexpr int NX = Model<S, N, Dev>::kNx;
-  using VecX = typename Model<S, N, Dev>::VecX;
-  const auto& dm = m.dev;
+struct EventAct {
+  const Model<S, N, Dev>& m;
+  Data<S, N, Dev>& d;
+  Stepper& st;
+  Vec& y;
+  S end_tol;
+
+  // Newton's law between the particle and the floor mass (Eq. 4).
+  Impact impact(int side) {
+    if constexpr (Dev::kLaw == ContactLaw::kRestitution) {
+      constexpr int NX = Model<S, N, Dev>::kNx;
+      using VecX = typename Model<S, N, Dev>::VecX;
+      const auto& dm = m.dev;
+      const S rd = st.rel_vel(y);
+      const S v_app = side < 0 ? -rd : rd;
+      if (v_app <= S(0)) return Impact::kNone;
+      S push, unused;  // the force that would hold the particle on the wall
+      const Mode before = st.mode;
+      st.mode = riding_at(side);
+      st.force(y, &push, &unused);
+      st.mode = before;
+      // The wall holds the particle with a force towards the box: + on the left.
+      const S a_in = std::fmax(side < 0 ? push : -push, S(0)) / dm.m_star;
+      const S v_stick = std::fmax(static_cast<S>(kStickSpeed), std::sqrt(S(2) * a_in * dm.count_depth));
+      const bool plastic = dm.eps * v_app < v_stick;
+      const S e = plastic ? S(0) : dm.eps;
+      const S j = contact::restitution_impulse(dm.m, S(1) / m.inv_floor_mass, v_app, e);
+      const S jp = side < 0 ? j : -j;  // impulse on the particle
+      y(NX + 1) += jp * dm.inv_m;
+      VecX z = y.template head<NX>();
+      m.lti.impulse(z, -jp);  // the floor takes the opposite impulse
+      y.template head<NX>() = z;
+      // The impact was placed up to the event tolerance past the wall: put
+      // the particle back on it, so that the next approach is seen again.
+      y(NX) += (side < 0 ? dm.wall_left : dm.wall_right) - st.rel_pos(y);
+      y(NX + 2) += S(0.5) * dm.m_star * (S(1) - e * e) * v_app * v_app;
+      if (v_app > static_cast<S>(kStickSpeed)) ++d.count.contacts;
+      return plastic ? Impact::kPlastic : Impact::kRebound;
+    } else {
+      (void)side;
+      return Impact::kNone;
+    }
+  }
+
+  // Riding wall `side` (the mode already set), the wall would have to pull.
+  bool pulls(int side) const {
+    S fp, loss;
+    st.force(y, &fp, &loss);
+    return (side < 0 && fp < S(0)) || (side > 0 && fp > S(0));
+  }
+
+  // q from the overlap with wall `side`; the contact's depth from zero.
+  void begin_contact(int side) {
+    const auto& dm = m.dev;
+    const S dl = side < 0 ? overlap_left<S>(dm, st.rel_pos(y)) : overlap_right<S>(dm, st.rel_pos(y));
+    y(Stepper::kQ) = std::sqrt(std::sqrt(std::fmax(dl, S(0))));
+    d.contact_depth = S(0);
+  }
+
+  // q reached zero: the contact ends (counted if deep enough), unless the
+  // walls still overlap (q and the overlap drifted apart): then q goes back
+  // on the overlap.
+  bool end_contact() {
+    const auto& dm = m.dev;
+    const S r = st.rel_pos(y);
+    const S dl = st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
+    if (dl > end_tol) {
+      y(Stepper::kQ) = std::sqrt(std::sqrt(dl));
+      return false;
+    }
+    if (d.contact_depth > m.dev.count_depth) ++d.count.contacts;
+    return true;
+  }
+};
+
+}  // namespace detail
+
+// What happens at a located event (side: -1 left wall, +1 right wall): the
+// contact-mode transition with the sub-stepper's actions (detail::EventAct).
+// Out of line: a rare path that both sub-steppers call from several places.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+VINES_NOINLINE void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side, S end_tol) {
 #ifdef VINES_TRACE
   std::printf("event t=%.6f mode=%d side=%d r=%.6e rd=%.6e depth=%.3e\n", d.time(m), (int)st.mode, side,
               (double)st.rel_pos(y), (double)st.rel_vel(y), (double)d.contact_depth);
 #endif
-  switch (st.mode) {
-    case Mode::kFree:
-      if constexpr (Dev::kLaw == ContactLaw::kRestitution) {
-        // Newton's law between the particle and the floor mass (Eq. 4).
-        const S rd = st.rel_vel(y);
-        const S v_app = side < 0 ? -rd : rd;
-        if (v_app <= S(0)) return;
-        S push, unused;  // the force that would hold the particle on the wall
-        const Mode before = st.mode;
-        st.mode = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
-        st.force(y, &push, &unused);
-        st.mode = before;
-        // The wall holds the particle with a force towards the box: + on the left.
-        const S a_in = std::fmax(side < 0 ? push : -push, S(0)) / dm.m_star;
-        const S v_stick = std::fmax(static_cast<S>(kStickSpeed), std::sqrt(S(2) * a_in * dm.count_depth));
-        const bool plastic = dm.eps * v_app < v_stick;
-        const S e = plastic ? S(0) : dm.eps;
-        const S j = contact::restitution_impulse(dm.m, S(1) / m.inv_floor_mass, v_app, e);
-        const S jp = side < 0 ? j : -j;  // impulse on the particle
-        y(NX + 1) += jp * dm.inv_m;
-        VecX z = y.template head<NX>();
-        m.lti.impulse(z, -jp);  // the floor takes the opposite impulse
-        y.template head<NX>() = z;
-        // The impact was placed up to the event tolerance past the wall: put
-        // the particle back on it, so that the next approach is seen again.
-        y(NX) += (side < 0 ? dm.wall_left : dm.wall_right) - st.rel_pos(y);
-        y(NX + 2) += S(0.5) * dm.m_star * (S(1) - e * e) * v_app * v_app;
-        if (v_app > static_cast<S>(kStickSpeed)) ++d.count.contacts;
-        if (plastic) {
-          st.mode = side < 0 ? Mode::kStuckLeft : Mode::kStuckRight;
-          S fp, loss;
-          st.force(y, &fp, &loss);
-          if ((side < 0 && fp < S(0)) || (side > 0 && fp > S(0))) st.mode = Mode::kFree;
-        }
-      } else {
-        st.mode = side < 0 ? Mode::kContactLeft : Mode::kContactRight;
-        const S dl = side < 0 ? overlap_left<S>(dm, st.rel_pos(y)) : overlap_right<S>(dm, st.rel_pos(y));
-        y(Stepper::kQ) = std::sqrt(std::sqrt(std::fmax(dl, S(0))));
-        d.contact_depth = S(0);
-      }
-      break;
-    case Mode::kContactLeft:
-    case Mode::kContactRight: {
-      // q reached zero: the contact ends, unless the walls still overlap (q
-      // and the overlap drifted apart): then q goes back on the overlap.
-      const S r = st.rel_pos(y);
-      const S dl = st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r);
-      if (dl > end_tol) {
-        y(Stepper::kQ) = std::sqrt(std::sqrt(dl));
-        break;
-      }
-      if (d.contact_depth > m.dev.count_depth) ++d.count.contacts;
-      st.mode = Mode::kFree;
-      break;
-    }
-    default:
-      st.mode = Mode::kFree;
-      break;
-  }
+  detail::EventAct<S, N, Dev, Stepper, Vec> act{m, d, st, y, end_tol};
+  take_event(st.mode, side, Dev::kLaw == ContactLaw::kRestitution, act);
 }
 
 // The same, with the event tolerance for the end of a contact.
@@ -288,103 +299,7 @@ void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec
   apply_event(m, d, st, y, side, m.dev.event_tol);
 }
 
-// An event due right now, before any time passes: 0 if none, else the wall
-// side (-1, +1). Contacts end once the overlap is gone; free particles start
-// a contact if they overlap a wall while approaching it; riding particles
-// leave the wall once the holding force would pull.
-template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
-  const auto& dm = m.dev;
-  const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = m.dev.event_tol;
-  switch (st.mode) {
-    case Mode::kFree: {
-      // An impact needs an approach speed the law resolves (a particle just
-      // released from a wall sits on it with a rounding-level speed).
-      const S v_min = Dev::kLaw == ContactLaw::kRestitution ? static_cast<S>(kStickSpeed) : S(0);
-      if (overlap_left<S>(dm, r) > tol && rd < -v_min) return -1;
-      if (overlap_right<S>(dm, r) > tol && rd > v_min) return 1;
-      return 0;
-    }
-    case Mode::kContactLeft:
-    case Mode::kContactRight: {
-      const S q = y(Stepper::kQ), ddl = st.overlap_rate(y);
-      const int side = st.mode == Mode::kContactLeft ? -1 : 1;
-      return q < S(0) || (q == S(0) && ddl <= S(0)) ? side : 0;
-    }
-    default: {
-      S fp, loss;
-      st.force(y, &fp, &loss);
-      // Leave once the wall would have to pull (beyond rounding: 1e-9 m/s^2).
-      const bool left = st.mode == Mode::kStuckLeft;
-      const S pull = (left ? -fp : fp) * m.dev.inv_m;
-      return pull > S(1e-9) ? (left ? -1 : 1) : 0;
-    }
-  }
-}
-
 namespace detail {
-
-// Event function of the stepper's mode for the state y (f: its derivative),
-// crossing zero upwards at the event; *slope its derivative. side -1, +1:
-// the wall (free), or the mode's event (contact: q returns to zero; riding
-// a wall: the holding force changes sign); side 0 in a contact: the end of
-// the sensor step (t = h).
-template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-VINES_INLINE S event_value(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y, const Vec& f, int side, S h,
-                           S* slope) {
-  constexpr int kT = Stepper::kT, kQ = Stepper::kQ;
-  const auto& dm = m.dev;
-  if (side == 0) {
-    *slope = f(kT);
-    return y(kT) - h;
-  }
-  const S r = st.rel_pos(y), rd = st.rel_vel(y);
-  switch (st.mode) {
-    case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
-      *slope = side < 0 ? -rd : rd;
-      return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - m.dev.event_tol;
-    case Mode::kContactLeft:  // q returns to zero
-    case Mode::kContactRight:
-      *slope = -f(kQ);
-      return -y(kQ);
-    default: {  // stuck: the holding force changes sign
-      S fp, loss;
-      st.force(y, &fp, &loss);
-      *slope = S(0);
-      return st.mode == Mode::kStuckLeft ? -fp : fp;
-    }
-  }
-}
-
-// Does an event happen inside the sub-step from (y0, f0) to (y1, f1), of
-// length hs? Which first? From the cubic Hermite interpolant of each event
-// function (linear for the holding force, whose slope is not known): true
-// and *theta (the fraction of the sub-step: the first up-crossing on the
-// cubic, bisected `halvings` times after a 16-point grid), *side; false if
-// none.
-template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y0, const Vec& f0,
-                              const Vec& y1, const Vec& f1, S hs, S h, int halvings, S* theta, int* side) {
-  const bool reg = st.regular();
-  bool any = false;
-  for (int sd = -1; sd <= 1; ++sd) {
-    if (sd == 0 && !reg) continue;           // t = h: only in w
-    if (st.mode != Mode::kFree && sd == 1) break;
-    S s0, s1;
-    const S g0 = event_value(m, st, y0, f0, sd, h, &s0), g1 = event_value(m, st, y1, f1, sd, h, &s1);
-    const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
-    const bool stuck = st.mode == Mode::kStuckLeft || st.mode == Mode::kStuckRight;
-    const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
-    if (!hit || g0 > S(0)) continue;
-    const S th = stuck ? g0 / (g0 - g1) : cub.first_upcrossing(halvings);
-    if (!any || th < *theta) {
-      *theta = th;
-      *side = sd;
-      any = true;
-    }
-  }
-  return any;
-}
 
 // The sub-steppers' state vector from the data block: floors (modal), the
 // particle, four zeroed integrals (contact loss, input, damping, E_e), time
@@ -436,7 +351,6 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   constexpr S kEps = std::numeric_limits<S>::epsilon();
   // Tolerances that the scalar can honour.
   const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * kEps);
-  const S event_tol = m.dev.event_tol;
   const int cap = m.loop.max_substeps_per_step;
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
@@ -450,14 +364,8 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   int n = 0;
   bool capped = false;
   ++d.count.careful_steps;
-  // Event function of the current mode (detail::event_value).
-  auto event_value = [&](const Vec& yy, const Vec& ff, int side, S* slope) {
-    return detail::event_value(m, st, yy, ff, side, h, slope);
-  };
-
   int immediate = 0;
-  S ln_en_old = std::log(S(1e-4));  // error of the last accepted sub-step (PI control)
-  bool rejected_last = false;
+  numeric::PiControl<S> control;  // the step-size controller (step_control.hpp)
   while (y(kT) < h) {
     // An event already due at the start of the sub-step (the state sits on
     // the far side of a switching surface within rounding): apply it now.
@@ -482,10 +390,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     auto r = numeric::dopri5_step<Vec>(st, u, y, f, hs);
     const S en = st.error_norm(r.err, y, r.y, rtol, rtol_scale);
     ++n;
-    if (!forced && !(en <= S(1))) {
+    if (!forced && !control.accepts(en)) {
       ++d.count.rejected;
-      (reg ? hc_w : hc_t) = hs * std::fmax(S(0.1), S(0.9) * std::pow(std::fmax(en, S(1e-10)), S(-0.2)));
-      rejected_last = true;
+      (reg ? hc_w : hc_t) = control.rejected(hs, en);
       continue;
     }
     if (forced) capped = true;
@@ -499,35 +406,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     const bool any = !forced && detail::first_event(m, st, y, f, r.y, r.f, hs, h, 20, &theta, &side);
 
     if (any && theta <= S(1)) {
-      // Place the event on the true sub-step, bracket [0, hs], from the
-      // cubic's estimate: Newton steps on the event function (its slope comes
-      // with each trial step) aimed at the middle of the acceptance band
-      // [0, tol], Illinois steps where Newton would leave the bracket. The
-      // step end (side 0) is placed to rounding of t.
-      const S tol = side == 0 ? S(4) * kEps * h : event_tol;
-      S lo = S(0), hi = hs, slope;
-      S glo = event_value(y, f, side, &slope);
-      S ghi = event_value(r.y, r.f, side, &slope);
-      if (!(ghi > S(0))) ghi = S(1);
-      S tau = theta * hs;
-      auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
-      int last = 0;
-      for (int it = 0; it < 40; ++it) {
-        const S g = event_value(rr.y, rr.f, side, &slope);
-        if (std::fabs(g) <= tol && g >= S(0)) break;
-        if (g > S(0)) { hi = tau; ghi = g; if (last == 1) glo *= S(0.5); last = 1; }
-        else { lo = tau; glo = g; if (last == -1) ghi *= S(0.5); last = -1; }
-        if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) {
-          tau = hi;
-        } else {
-          tau = slope > S(0) ? tau - (g - S(0.5) * tol) / slope : lo;
-          if (!(tau > lo && tau < hi))
-            tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
-          if (!(tau > lo && tau < hi)) tau = S(0.5) * (lo + hi);
-        }
-        rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
-        if (tau == hi && hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) break;
-      }
+      // Place the event on the true sub-step (detail::locate_event).
+      S tau;
+      const auto rr = detail::locate_event(m, st, u, y, f, r.y, r.f, hs, h, theta, side, &tau);
       // Accept up to the event.
       track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), d.time(m) + static_cast<double>(rr.y(kT)));
       u += tau;
@@ -564,16 +445,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
-    {
-      // PI step-size control (Gustafsson; Hairer's DOPRI5 constants): no
-      // growth right after a rejection.
-      const S ln_en = std::log(std::fmax(en, S(1e-4)));
-      S fac = S(0.9) * std::exp(S(-0.17) * ln_en + S(0.04) * ln_en_old);
-      fac = std::fmin(rejected_last ? S(1) : S(5), std::fmax(S(0.2), fac));
-      (reg ? hc_w : hc_t) = hs * fac;
-      ln_en_old = ln_en;
-      rejected_last = false;
-    }
+    (reg ? hc_w : hc_t) = control.accepted(hs, en);
     if (forced || y(kT) >= h * (S(1) - S(8) * kEps)) break;
   }
   if (capped) ++d.count.cap_hits;

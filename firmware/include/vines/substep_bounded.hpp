@@ -51,6 +51,7 @@
 #include <Eigen/Core>
 
 #include "vines/data.hpp"
+#include "vines/events.hpp"
 #include "vines/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
@@ -82,23 +83,6 @@ inline constexpr double kStableStep = 1.0;
 // fraction past its end, else the step ends where it stands.
 inline constexpr double kMaxExtrapolation = 1.5;
 
-// Newton steps on the cubic c from theta, kept inside [lo, hi] where c
-// rises through zero (bisection where Newton would leave it).
-template <typename S>
-S polish_root(const numeric::Cubic<S>& c, S theta, S lo, S hi) {
-  for (int it = 0; it < kBoundedRootIterations; ++it) {
-    const S v = c.value(theta);
-    if (v > S(0)) hi = theta;
-    else lo = theta;
-    const S slope = c.slope(theta);
-    S next = slope > S(0) ? theta - v / slope : S(0.5) * (lo + hi);
-    if (!(next >= lo && next <= hi)) next = S(0.5) * (lo + hi);
-    if (next == theta) break;
-    theta = next;
-  }
-  return theta;
-}
-
 // Free flight: the earliest time in (0, span] at which the overlap with a
 // wall reaches the event tolerance, on the overlap's Taylor cubic (exact for
 // the particle, whose acceleration is -a_g; to the floor's jerk for the
@@ -123,7 +107,7 @@ S predict_start(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y, cons
     const auto c = numeric::Cubic<S>::make(g0, g1, g_end, d_end, span);
     if (!(c.max_value() > S(0))) continue;
     const S th = c.first_upcrossing(20);
-    const S t = span * polish_root(c, th, S(0), S(1));
+    const S t = span * polish_root<kBoundedRootIterations>(c, th, S(0), S(1));
     if (t > S(0) && (best == S(0) || t < best)) best = t;
   }
   return best;
@@ -252,10 +236,9 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   bool short_of_budget = false;
   ++d.count.careful_steps;
 
-  auto in_contact = [&] { return st.mode == Mode::kContactLeft || st.mode == Mode::kContactRight; };
-  // An event may be applied: a contact's end while a slot is left, anything
+    // An event may be applied: a contact's end while a slot is left, anything
   // else only with a slot left for the end of the contact it may start.
-  auto may_apply = [&] { return in_contact() ? events < kBoundedEvents : events + 2 <= kBoundedEvents; };
+  auto may_apply = [&] { return in_contact(st.mode) ? events < kBoundedEvents : events + 2 <= kBoundedEvents; };
   auto apply = [&](int side) {
     ++events;
     ++d.count.events;
@@ -322,11 +305,12 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     const bool any = detail::first_event(m, st, y, f, r.y, r.f, hs, h, 20, &theta, &side) && theta <= S(1);
     const bool step_end = any && side == 0;
     if (any && (step_end || (may_apply() && (reg || taken < budget)))) {
-      if (st.mode != Mode::kStuckLeft && st.mode != Mode::kStuckRight) {
+      if (!riding(st.mode)) {
         S s0, s1;
         const S g0 = detail::event_value(m, st, y, f, side, h, &s0);
         const S g1 = detail::event_value(m, st, r.y, r.f, side, h, &s1);
-        theta = detail::polish_root(numeric::Cubic<S>::make(g0, s0, g1, s1, hs), theta, S(0), S(1));
+        const auto c = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
+        theta = detail::polish_root<detail::kBoundedRootIterations>(c, theta, S(0), S(1));
       }
       y = detail::interpolate_to(m, d, st.mode, y, f, r.y, r.f, hs, theta);
       if (step_end) {
@@ -363,7 +347,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
         const auto c = numeric::Cubic<S>::make(y0(kT) - h, f0(kT), y(kT) - h, f(kT), hs);
         if (c.value(reach) > S(0)) {
           short_of_budget = true;
-          const S th = detail::polish_root(c, S(1), S(1), reach);
+          const S th = detail::polish_root<detail::kBoundedRootIterations>(c, S(1), S(1), reach);
           const Vec y1 = y;
           y = numeric::hermite_point(y0, f0, y1, f, hs, th);
           y(kT) = h;
