@@ -56,7 +56,7 @@
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/substep.hpp"
+#include "vines/substep_common.hpp"
 
 namespace vines {
 
