@@ -1,5 +1,5 @@
 // One CSV writer for the files the commands write (sweep results.csv, run
-// timeseries.csv, bench --csv): comma-separated cells, one row a line; a
+// timeseries.csv, bench --csv, hil --csv): comma-separated cells, one row a line; a
 // text cell is quoted when it holds a comma, a quote or a line break (quotes
 // doubled, RFC 4180), or always with quoted(); numbers in a printf format.
 // Writes are checked: a file that cannot be opened or written throws a

@@ -1,10 +1,8 @@
 #include "sim_host/hil_report.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <stdexcept>
 
+#include "sim_host/csv.hpp"
 #include "sim_host/hil_record.hpp"
 
 namespace vines::host {
@@ -104,32 +102,30 @@ json to_json(const HilReport& r) {
 
 void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
                    int stories, double h) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error("--csv " + path + ": cannot write");
+  CsvWriter f(path);
   const bool hybrid = !rec.table_x.empty();
   const int n = stories;
   // Header, then one row per sample (a sample without telemetry: zeros).
-  f << "k,t_s,ag_sent_mps2,ag_used_mps2,received,flags,latency_us,x_top_m,x_top_offline_m,deviation_m,acc_top_mps2,"
-       "Ee_Js,particle_x_m,contact_force_n,dissipated_J,aux,drift_alarms";
-  if (hybrid) f << ",table_x_m,force_measured_n";
-  f << '\n';
-  char buf[512];
+  for (const char* c : {"k", "t_s", "ag_sent_mps2", "ag_used_mps2", "received", "flags", "latency_us", "x_top_m",
+                        "x_top_offline_m", "deviation_m", "acc_top_mps2", "Ee_Js", "particle_x_m", "contact_force_n",
+                        "dissipated_J", "aux", "drift_alarms"})
+    f.raw(c);
+  if (hybrid) f.raw("table_x_m").raw("force_measured_n");
+  f.end_row();
+  constexpr const char* kFull = "%.17g";
   for (long long k = 0; k < rec.samples; ++k) {
     const link::Telemetry& t = rec.tel[k];
     const bool got = rec.got[k];
-    std::snprintf(buf, sizeof buf, "%lld,%.6f,%.17g,%.17g,%d,%u,%.1f,%.17g,%.17g,%.3g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%llu",
-                  k, static_cast<double>(k) * h, rec.sensed[k], t.ag, got ? 1 : 0, t.flags,
-                  got ? 1e6 * (rec.arrival[k] - rec.handled[k]) : 0.0, t.x[n - 1], offline[k].x[n - 1],
-                  got ? std::fabs(t.x[n - 1] - offline[k].x[n - 1]) : 0.0, t.acc_top, t.elastic_energy,
-                  t.particle_x, t.contact_force, t.dissipated, t.aux,
-                  static_cast<unsigned long long>(t.drift_alarms));
-    f << buf;
-    if (hybrid) {
-      std::snprintf(buf, sizeof buf, ",%.17g,%.17g", rec.table_x[k], rec.force[k]);
-      f << buf;
-    }
-    f << '\n';
+    f.integer(k).number(static_cast<double>(k) * h, "%.6f").number(rec.sensed[k], kFull).number(t.ag, kFull);
+    f.integer(got ? 1 : 0).integer(t.flags).number(got ? 1e6 * (rec.arrival[k] - rec.handled[k]) : 0.0, "%.1f");
+    f.number(t.x[n - 1], kFull).number(offline[k].x[n - 1], kFull);
+    f.number(got ? std::fabs(t.x[n - 1] - offline[k].x[n - 1]) : 0.0, "%.3g");
+    for (double v : {t.acc_top, t.elastic_energy, t.particle_x, t.contact_force, t.dissipated, t.aux}) f.number(v, kFull);
+    f.raw(std::to_string(static_cast<unsigned long long>(t.drift_alarms)));
+    if (hybrid) f.number(rec.table_x[k], kFull).number(rec.force[k], kFull);
+    f.end_row();
   }
+  f.close();
 }
 
 }  // namespace vines::host
