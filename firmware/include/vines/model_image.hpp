@@ -44,8 +44,10 @@
 // modal report; host Engine::info() documents what it then lacks).
 //
 // Adding a field (another LoopParams or DeviceModel member): one line in
-// visit_fields at the marked spot; the size, field count and layout check
-// follow from it (a host and a node then need the same sources). A member
+// visit_fields at the marked spot (a contact law's coefficients come from
+// its kernel: coefficients(), contact.hpp); the size, field count and
+// layout check follow from it (a host and a node then need the same
+// sources). A member
 // added at the end of LoopParams or of the VI NES DeviceModel without its
 // line stops the build (static_assert tripwires naming the last member
 // carried: move them to the new one). Bump kVersion when the meaning of
@@ -63,6 +65,7 @@
 
 #include <Eigen/Core>
 
+#include "vines/contact_laws.hpp"
 #include "vines/link/crc32.hpp"
 #include "vines/model.hpp"
 
@@ -301,9 +304,8 @@ constexpr void visit_fields(V& v) {
     for (auto f : {&DM::m, &DM::m_star, &DM::inv_m, &DM::wall_left, &DM::wall_right, &DM::y0, &DM::v0, &DM::c,
                    &DM::eps})
       v(all, &M::dev, f);
-    v(all, &M::dev, &DM::law, &Law::c);
-    if constexpr (Dev::kLaw == ContactLaw::kTsuji || Dev::kLaw == ContactLaw::kKuwabara)
-      v(all, &M::dev, &DM::law, &Law::g);
+    // The law's coefficients, as its kernel lists them (contact_laws.hpp).
+    Law::coefficients([&](auto coefficient) { v(all, &M::dev, &DM::law, coefficient); });
     for (auto f : {&DM::pos_scale, &DM::vel_scale, &DM::modal_scale, &DM::q_scale, &DM::w_step0, &DM::ff_a0,
                    &DM::ff_a1, &DM::ff_v, &DM::count_depth, &DM::event_tol, &DM::round_tol, &DM::clear_lo,
                    &DM::clear_hi})
@@ -450,16 +452,6 @@ inline const char* device_text(std::uint8_t kind) {
     default: return nullptr;
   }
 }
-inline const char* law_text(std::uint8_t law) {
-  switch (law) {
-    case static_cast<std::uint8_t>(ContactLaw::kHertz): return "hertz";
-    case static_cast<std::uint8_t>(ContactLaw::kTsuji): return "tsuji";
-    case static_cast<std::uint8_t>(ContactLaw::kKuwabara): return "kuwabara";
-    case static_cast<std::uint8_t>(ContactLaw::kRestitution): return "restitution";
-    default: return nullptr;
-  }
-}
-
 // A message assembled in a caller's buffer (no printf: integers only).
 class Text {
  public:
@@ -492,7 +484,7 @@ class Text {
     s(k);
     if (kind != static_cast<std::uint8_t>(DeviceKind::kVines))
       return law == kNoLaw ? *this : s(" (law code ").u(law).s(")");
-    const char* l = law_text(law);
+    const char* l = law_name(static_cast<ContactLaw>(law));
     if (!l) return s(" (law code ").u(law).s(")");
     return s(" (").s(l).s(")");
   }
