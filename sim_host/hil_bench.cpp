@@ -3,11 +3,26 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sim_host/hil_offline.hpp"
+#include "vines/contact_laws.hpp"
 
 namespace vines::host {
 namespace {
+
+// "hertz, tsuji or kuwabara": the laws of finite contact duration, from the
+// registry (vines/contact_laws.hpp).
+std::string finite_laws() {
+  std::vector<std::string> names;
+  each_law([&](auto law) {
+    if (!decltype(law)::kImpulsive) names.emplace_back(decltype(law)::kName);
+  });
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return out;
+}
 
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
 
@@ -66,9 +81,9 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   // is compensated by default for the actuator's delay and lag (2 zeta / w).
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
-  if (hybrid && (sc.params.device.kind != DeviceKind::kVines || sc.params.device.vines.law == ContactLaw::kRestitution))
-    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law "
-                             "(hertz, tsuji or kuwabara): the table's load cell measures contact forces");
+  if (hybrid && (sc.params.device.kind != DeviceKind::kVines || law_impulsive(sc.params.device.vines.law)))
+    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law (" +
+                             finite_laws() + "): the table's load cell measures contact forces");
   if (hybrid && o.comp_delay_s < 0) o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz);
   if (o.comp_delay_s < 0) o.comp_delay_s = 0;
   b.cfg = node_config(sc, o);

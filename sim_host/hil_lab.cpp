@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "vines/contact.hpp"
+#include "vines/contact_laws.hpp"
 
 namespace vines::host {
 
@@ -17,13 +17,15 @@ ShakeTable::ShakeTable(const VinesDesign& d, ContactLaw law, double particle_x0,
 }
 
 double ShakeTable::contact_force(double s, double sd, double xt, double vt) const {
+  // The law's force; none for an instantaneous law (refused by the bench: a
+  // load cell sees no impulse).
   auto kernel = [&](double d, double dd) {
-    switch (law_) {
-      case ContactLaw::kHertz: return contact::Hertz<double>{d_.c}(d, dd).total();
-      case ContactLaw::kTsuji: return contact::Tsuji<double>{d_.c, d_.g}(d, dd).total();
-      case ContactLaw::kKuwabara: return contact::Kuwabara<double>{d_.c, d_.g}(d, dd).total();
-      default: return 0.0;  // restitution: refused by the bench (a load cell sees no impulse)
-    }
+    double f = 0.0;
+    with_law(law_, [&](auto law) {
+      using L = decltype(law);
+      if constexpr (!L::kImpulsive) f = L::template kernel<double>(d_)(d, dd).total();
+    });
+    return f;
   };
   const double left = (xt - d_.gap) - s, right = s - (xt + d_.gap);
   if (left > 0) return kernel(left, vt - sd);

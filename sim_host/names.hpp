@@ -1,6 +1,8 @@
-// Names of the model's choices as scene files and outputs spell them.
+// Names of the model's choices as scene files and outputs spell them (a
+// contact law's: law_name, vines/contact_laws.hpp).
 #pragma once
 
+#include "vines/contact_laws.hpp"
 #include "vines/params.hpp"
 
 namespace vines::host {
@@ -10,15 +12,6 @@ inline const char* device_name(DeviceKind k) {
     case DeviceKind::kTmd: return "tmd";
     case DeviceKind::kVines: return "vines";
     default: return "none";
-  }
-}
-
-inline const char* law_name(ContactLaw l) {
-  switch (l) {
-    case ContactLaw::kHertz: return "hertz";
-    case ContactLaw::kTsuji: return "tsuji";
-    case ContactLaw::kKuwabara: return "kuwabara";
-    default: return "restitution";
   }
 }
 

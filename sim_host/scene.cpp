@@ -15,7 +15,8 @@
 //             initial_position_m, initial_velocity_mps
 //   [vines]   radius_m, density_kg_m3, young_pa, poisson, wall_young_pa,
 //             wall_poisson, beta | box_length_m (not both),
-//             law = "kuwabara" | "tsuji" | "hertz" | "restitution", eps,
+//             law = "kuwabara" | "tsuji" | "hertz" | "restitution" (the
+//             laws of vines/contact_laws.hpp), eps,
 //             v_ref_mps | tau_s (not both), initial_position_m,
 //             initial_velocity_mps. Without initial_position_m the particle
 //             starts against the left wall.
@@ -61,6 +62,7 @@
 
 #include "sim_host/scene_section.hpp"
 #include "sim_host/scene_toml.hpp"
+#include "vines/contact_laws.hpp"
 #include "vines/frame_presets.hpp"
 #include "vines/validate.hpp"
 
@@ -69,6 +71,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace scene_detail;
+
+// The contact laws a scene may name: the registry's (vines/contact_laws.hpp).
+Choices<ContactLaw> law_choices() {
+  Choices<ContactLaw> out;
+  each_law([&](auto law) { out.emplace_back(decltype(law)::kName, decltype(law)::kTag); });
+  return out;
+}
 
 // ---- [frame] ----
 void read_frame(const Section& s, FrameParams* f) {
@@ -145,12 +154,7 @@ void read_vines(const Section& s, VinesParams* v) {
   s.exclusive("beta", "box_length_m");
   s.read("beta", &v->beta);
   s.read_nonzero("box_length_m", &v->box_length_m);
-  s.choose<ContactLaw>("law",
-                       {{"kuwabara", ContactLaw::kKuwabara},
-                        {"tsuji", ContactLaw::kTsuji},
-                        {"hertz", ContactLaw::kHertz},
-                        {"restitution", ContactLaw::kRestitution}},
-                       &v->law);
+  s.choose<ContactLaw>("law", law_choices(), &v->law);
   s.read("eps", &v->eps);
   s.exclusive("v_ref_mps", "tau_s");
   s.read("v_ref_mps", &v->v_ref_mps);

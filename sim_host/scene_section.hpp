@@ -38,7 +38,7 @@ inline std::string join(std::initializer_list<std::string_view> names) {
 
 // A name -> value table for string-valued choices.
 template <class E>
-using Choices = std::initializer_list<std::pair<std::string_view, E>>;
+using Choices = std::vector<std::pair<std::string_view, E>>;
 
 // One top-level table of the scene file. The constructor refuses keys not in
 // `known`. Each read() leaves *out alone and returns false when the key is

@@ -42,9 +42,6 @@ constexpr RecordFile kRecordFiles[] = {
     {"mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt", hal::RecordFormat::kTimeAccel, hal::Units::kG, 2},
 };
 
-constexpr ContactLaw kLaws[] = {ContactLaw::kHertz, ContactLaw::kTsuji, ContactLaw::kKuwabara,
-                                ContactLaw::kRestitution};
-
 const char* damping_name(DampingRule d) {
   switch (d) {
     case DampingRule::kRayleigh: return "rayleigh";
@@ -178,9 +175,10 @@ StressCase draw_case(std::uint64_t seed, std::int64_t index, const std::vector<S
   c.seed = seed;
   c.index = index;
   SceneParams& p = c.params;
-  // The bare frame or a VI NES with one of the four laws, equally likely; a
-  // frame size among those compiled; float (where compiled) one case in four.
-  const int device = rng.integer(0, 4);
+  // The bare frame or a VI NES with one of the laws, equally likely; a frame
+  // size among those compiled; float (where compiled) one case in four. A
+  // law's code is its line in the registry's table (contact_laws.hpp).
+  const int device = rng.integer(0, kContactLawCount);
   const DeviceKind kind = device == 0 ? DeviceKind::kNone : DeviceKind::kVines;
   const std::vector<int> frames = compiled_frames(Scalar::kDouble, kind);
   const int n = frames[static_cast<std::size_t>(rng.integer(0, static_cast<int>(frames.size()) - 1))];
@@ -188,7 +186,7 @@ StressCase draw_case(std::uint64_t seed, std::int64_t index, const std::vector<S
   const bool has_float = std::find(floats.begin(), floats.end(), n) != floats.end();
   if (rng.uniform(0.0, 1.0) < 0.25 && has_float) c.scalar = Scalar::kFloat;
   draw_frame(rng, n, &p.frame);
-  if (kind == DeviceKind::kVines) draw_vines(rng, kLaws[device - 1], first_mode(p.frame).m_eff, &p.device, n);
+  if (kind == DeviceKind::kVines) draw_vines(rng, static_cast<ContactLaw>(device - 1), first_mode(p.frame).m_eff, &p.device, n);
 
   // Sensor 50 Hz-20 kHz (log-uniform). The stress looks for numerical trouble,
   // not for implausible buildings: the divergence guard is set far beyond any

@@ -174,17 +174,15 @@ struct Inst {
   static constexpr DeviceKind kKind = K;
   static constexpr ContactLaw kLaw = L;
 };
-using Instances = ::testing::Types<
-    Inst<double, NoDevice, DeviceKind::kNone>, Inst<float, NoDevice, DeviceKind::kNone>,
-    Inst<double, TmdDevice, DeviceKind::kTmd>, Inst<float, TmdDevice, DeviceKind::kTmd>,
-    Inst<double, VinesDevice<ContactLaw::kHertz>, DeviceKind::kVines, ContactLaw::kHertz>,
-    Inst<float, VinesDevice<ContactLaw::kHertz>, DeviceKind::kVines, ContactLaw::kHertz>,
-    Inst<double, VinesDevice<ContactLaw::kTsuji>, DeviceKind::kVines, ContactLaw::kTsuji>,
-    Inst<float, VinesDevice<ContactLaw::kTsuji>, DeviceKind::kVines, ContactLaw::kTsuji>,
-    Inst<double, Kuwabara, DeviceKind::kVines, ContactLaw::kKuwabara>,
-    Inst<float, Kuwabara, DeviceKind::kVines, ContactLaw::kKuwabara>,
-    Inst<double, VinesDevice<ContactLaw::kRestitution>, DeviceKind::kVines, ContactLaw::kRestitution>,
-    Inst<float, VinesDevice<ContactLaw::kRestitution>, DeviceKind::kVines, ContactLaw::kRestitution>>;
+// No device, the TMD, and a VI NES with each law of the registry
+// (contact_laws.hpp), in double and float.
+template <typename... Ls>
+::testing::Types<Inst<double, NoDevice, DeviceKind::kNone>, Inst<float, NoDevice, DeviceKind::kNone>,
+                 Inst<double, TmdDevice, DeviceKind::kTmd>, Inst<float, TmdDevice, DeviceKind::kTmd>,
+                 Inst<double, VinesDevice<Ls::kTag>, DeviceKind::kVines, Ls::kTag>...,
+                 Inst<float, VinesDevice<Ls::kTag>, DeviceKind::kVines, Ls::kTag>...>
+instances_of(LawTable<Ls...>);
+using Instances = decltype(instances_of(ContactLaws{}));
 
 template <typename T>
 class ModelImage : public ::testing::Test {};

@@ -213,9 +213,10 @@ TEST(Stress, TooSmallSubstepCapIsReportedOnEveryStressFrame) {
   a.resize(2001);
   for (double& x : a) x *= 3.0;
   for (int n : compiled_frames(Scalar::kDouble, DeviceKind::kVines))
-    for (ContactLaw law : {ContactLaw::kHertz, ContactLaw::kTsuji, ContactLaw::kKuwabara, ContactLaw::kRestitution}) {
+    for (int code = 0; code < kContactLawCount; ++code) {
+      const ContactLaw law = static_cast<ContactLaw>(code);
       SCOPED_TRACE(n);
-      SCOPED_TRACE(static_cast<int>(law));
+      SCOPED_TRACE(law_name(law));
       SceneParams p = tall_vines(n, law);
       const test::Outcome fine = test::run(p, a);
       EXPECT_GT(fine.totals.count.contacts, 0);

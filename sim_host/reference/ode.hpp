@@ -16,6 +16,7 @@
 
 #include "sim_host/reference/spec.hpp"
 #include "vines/contact.hpp"
+#include "vines/contact_laws.hpp"
 #include "vines/contact_mode.hpp"
 
 namespace vines::host::reference {
@@ -47,8 +48,6 @@ class SceneOde {
     m_floor_ = T(s.frame.m[static_cast<std::size_t>(f_)]);
     m_star_ = T(d.m_star);
     eps_ = T(d.eps);
-    law_c_ = T(d.c);
-    law_g_ = T(d.g);
     wall_left_ = T(s.wall_left);
     wall_right_ = T(s.wall_right);
     // Overlaps below this do not start a contact: rounding of the relative
@@ -61,7 +60,7 @@ class SceneOde {
   int size() const { return 2 * p_ + 1; }
   int floors() const { return n_; }
   bool has_particle() const { return spec_.kind == DeviceKind::kVines; }
-  bool restitution() const { return has_particle() && spec_.law == ContactLaw::kRestitution; }
+  bool restitution() const { return has_particle() && law_impulsive(spec_.law); }
   int energy_index() const { return 2 * p_; }
   T top_x(const T* y) const { return y[n_ - 1]; }
   T top_v(const T* y) const { return y[p_ + n_ - 1]; }
@@ -166,19 +165,18 @@ class SceneOde {
     return f;
   }
 
+  // The force of the scene's law (contact_laws.hpp), in T.
   T law_force(T d, T dd) const {
-    switch (spec_.law) {
-      case ContactLaw::kTsuji: return contact::Tsuji<T>{law_c_, law_g_}(d, dd).total();
-      case ContactLaw::kKuwabara: return contact::Kuwabara<T>{law_c_, law_g_}(d, dd).total();
-      default: return contact::Hertz<T>{law_c_}(d, dd).total();
-    }
+    T f = T(0);
+    with_law(spec_.law, [&](auto law) { f = decltype(law)::template kernel<T>(spec_.vines)(d, dd).total(); });
+    return f;
   }
 
   OdeSpec spec_;
   int n_, p_, f_;
   std::vector<T> K_, C_, inv_m_;
   std::vector<int> band_lo_, band_hi_;
-  T m_dev_ = T(0), m_floor_ = T(0), m_star_ = T(0), eps_ = T(1), law_c_ = T(0), law_g_ = T(0);
+  T m_dev_ = T(0), m_floor_ = T(0), m_star_ = T(0), eps_ = T(1);
   T wall_left_ = T(0), wall_right_ = T(0), start_depth_ = T(0);
 };
 

@@ -3,12 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
+#include <type_traits>
 
 #include "vines/bounce.hpp"
 #include "vines/contact.hpp"
+#include "vines/contact_laws.hpp"
 #include "vines/devices.hpp"
 #include "vines/frame.hpp"
 #include "vines/frame_presets.hpp"
+#include "vines/validate.hpp"
 
 namespace {
 
@@ -99,6 +104,33 @@ TEST(Restitution, ImpulseReversesTheApproachSpeed) {
   // Relative speed after = -eps * before; momentum conserved by construction.
   const double dv1 = -j / m1, dv2 = j / m2;
   EXPECT_NEAR((v + dv1 - dv2) / v, -eps, 1e-14);
+}
+
+// ---- the registry (contact_laws.hpp)
+
+TEST(ContactLaws, EachLawHasItsPlaceAsCodeAndADistinctName) {
+  int place = 0;
+  std::set<std::string> names;
+  each_law([&](auto law) {
+    using L = decltype(law);
+    EXPECT_EQ(static_cast<int>(L::kTag), place++);
+    EXPECT_STREQ(law_name(L::kTag), L::kName);
+    EXPECT_TRUE(names.insert(L::kName).second) << L::kName;
+    EXPECT_TRUE((std::is_same_v<LawOf<L::kTag>, L>));
+  });
+  EXPECT_EQ(place, kContactLawCount);
+  const ContactLaw unknown = static_cast<ContactLaw>(kContactLawCount);
+  EXPECT_EQ(law_name(unknown), nullptr);
+  EXPECT_FALSE(with_law(unknown, [](auto) {}));
+}
+
+TEST(ContactLaws, AnUnknownLawCodeIsRefusedByValidation) {
+  DeviceParams d;
+  d.kind = DeviceKind::kVines;
+  d.vines.law = static_cast<ContactLaw>(kContactLawCount);
+  const ParamError e = validate(d, 10);
+  ASSERT_FALSE(e.ok());
+  EXPECT_STREQ(e.field, "vines.law");
 }
 
 }  // namespace

@@ -44,6 +44,8 @@ inline double tsuji_d(double eps) {
 
 // Each law also gives its force in terms of q = d^{1/4} (regular(q, dd)):
 // a polynomial in q, what the loop integrates contacts in (substep.hpp).
+// coefficients(f) calls f with a pointer to each coefficient member, in
+// order: the model image carries them (model_image_fields.hpp).
 
 // F = C d^{3/2}.
 template <typename S>
@@ -57,6 +59,8 @@ struct Hertz {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, S(0)};
   }
+  template <typename F>
+  static constexpr void coefficients(F&& f) { f(&Hertz::c); }
 };
 
 // F = C d^{3/2} + D(eps) sqrt(C m*) d^{1/4} dd, with g = D sqrt(C m*).
@@ -73,6 +77,11 @@ struct Tsuji {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, g * q * dd};
   }
+  template <typename F>
+  static constexpr void coefficients(F&& f) {
+    f(&Tsuji::c);
+    f(&Tsuji::g);
+  }
 };
 
 // Kuwabara-Kono: F = C d^{3/2} + (3/2) C tau d^{1/2} dd, with g = 1.5 C tau.
@@ -88,6 +97,11 @@ struct Kuwabara {
   Force<S> regular(S q, S dd) const {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, g * q2 * dd};
+  }
+  template <typename F>
+  static constexpr void coefficients(F&& f) {
+    f(&Kuwabara::c);
+    f(&Kuwabara::g);
   }
 };
 

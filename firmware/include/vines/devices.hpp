@@ -1,12 +1,13 @@
 // The devices a frame can carry, as compile-time policies: a scene with no
-// device compiles no device code, and a VI NES compiles only its contact law.
+// device compiles no device code, and a VI NES compiles only its contact law
+// (one of contact_laws.hpp).
 // Each has a design step (parameters -> constants) done once in double.
 #pragma once
 
 #include <cmath>
 
-#include "vines/bounce.hpp"
 #include "vines/contact.hpp"
+#include "vines/contact_laws.hpp"
 #include "vines/params.hpp"
 
 namespace vines {
@@ -49,16 +50,7 @@ inline TmdDesign design_tmd(const TmdParams& p, double mass, double m_eff1, doub
   return d;
 }
 
-// ---- VI NES: sphere, box, contact constants ----
-struct VinesDesign {
-  double mass = 0, radius = 0, box_length = 0, gap = 0;  // gap: free travel of the centre
-  double c = 0;       // Hertz prefactor
-  double m_star = 0;  // particle/floor reduced mass (Tsuji, restitution)
-  double eps = 1, tau = 0, v_ref = 0;
-  double g = 0;       // rate-term prefactor of the law (Tsuji or Kuwabara)
-  bool ok = true;     // false: tau could not be calibrated
-};
-
+// ---- VI NES: sphere, box, then the law's design step (contact_laws.hpp) ----
 inline VinesDesign design_vines(const VinesParams& p, double mass, double floor_mass) {
   constexpr double kPi = 3.14159265358979323846;
   VinesDesign d;
@@ -73,21 +65,8 @@ inline VinesDesign design_vines(const VinesParams& p, double mass, double floor_
   d.gap = 0.5 * d.box_length - d.radius;
   d.c = contact::hertz_c(p.young_pa, p.poisson, p.wall_young_pa, p.wall_poisson, d.radius);
   d.m_star = d.mass * floor_mass / (d.mass + floor_mass);
-  d.eps = p.law == ContactLaw::kHertz ? 1.0 : p.eps;
   d.v_ref = p.v_ref_mps;
-  switch (p.law) {
-    case ContactLaw::kTsuji:
-      d.g = contact::tsuji_d(d.eps) * std::sqrt(d.c * d.m_star);
-      break;
-    case ContactLaw::kKuwabara:
-      // tau from a rebound on a fixed rigid wall (particle mass alone).
-      d.tau = p.tau_s > 0.0 ? p.tau_s : calibrate_kuwabara_tau(d.c, d.mass, d.eps, d.v_ref);
-      d.ok = d.tau >= 0.0;
-      d.g = 1.5 * d.c * d.tau;
-      break;
-    default:
-      break;
-  }
+  with_law(p.law, [&](auto law) { decltype(law)::design(p, &d); });
   return d;
 }
 

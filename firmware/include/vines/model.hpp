@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "vines/contact_laws.hpp"
 #include "vines/devices.hpp"
 #include "vines/frame.hpp"
 #include "vines/lti.hpp"
@@ -66,11 +67,8 @@ struct DeviceModel<S, VinesDevice<L>> {
   S y0, v0;                 // initial position (from the box centre) and velocity
   S c;                      // Hertz prefactor, for the stored contact energy
   S eps;
-  // The law's kernel (unused for the instantaneous law).
-  std::conditional_t<L == ContactLaw::kTsuji, contact::Tsuji<S>,
-                     std::conditional_t<L == ContactLaw::kKuwabara, contact::Kuwabara<S>,
-                                        contact::Hertz<S>>>
-      law;
+  // The law's kernel (contact_laws.hpp; unused for the instantaneous law).
+  typename LawOf<L>::template Kernel<S> law;
   // Error scales of the sub-stepper: a position and a speed typical of
   // contacts, q = d^{1/4} of that position, and a first step in w (q moves
   // by ~2 % of its scale).
@@ -355,9 +353,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.v0 = static_cast<S>(vp.initial_velocity_mps);
     dm.c = static_cast<S>(d.c);
     dm.eps = static_cast<S>(d.eps);
-    dm.law.c = static_cast<S>(d.c);
-    if constexpr (Dev::kLaw == ContactLaw::kTsuji || Dev::kLaw == ContactLaw::kKuwabara)
-      dm.law.g = static_cast<S>(d.g);
+    dm.law = LawOf<Dev::kLaw>::template kernel<S>(d);
     const double v_scale = vp.v_ref_mps > 0.0 ? vp.v_ref_mps : 0.5;
     dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));
     dm.vel_scale = static_cast<S>(v_scale);

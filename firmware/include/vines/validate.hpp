@@ -5,20 +5,11 @@
 
 #include <cmath>
 
+#include "vines/contact_laws.hpp"
+#include "vines/param_error.hpp"
 #include "vines/params.hpp"
 
 namespace vines {
-
-struct ParamError {
-  const char* field = nullptr;    // dotted scene key, e.g. "vines.beta"
-  const char* message = nullptr;  // what is wrong, e.g. "must be > 1"
-  int index = -1;                 // array element (0-based), -1 if none
-  bool ok() const { return field == nullptr; }
-};
-
-namespace detail {
-inline bool finite_positive(double x) { return std::isfinite(x) && x > 0.0; }
-}  // namespace detail
 
 inline ParamError validate(const FrameParams& f) {
   using detail::finite_positive;
@@ -88,15 +79,10 @@ inline ParamError validate(const DeviceParams& d, int stories) {
   } else if (!(std::isfinite(v.beta) && v.beta > 1.0)) {
     return {"vines.beta", "must be > 1 (the box must be longer than the sphere)"};
   }
-  if (v.law != ContactLaw::kHertz && !(std::isfinite(v.eps) && v.eps > 0.0 && v.eps <= 1.0))
-    return {"vines.eps", "must be in (0, 1]"};
-  if (v.law == ContactLaw::kKuwabara) {
-    if (v.tau_s != 0.0) {
-      if (!std::isfinite(v.tau_s) || v.tau_s < 0.0) return {"vines.tau_s", "must be >= 0"};
-    } else if (!finite_positive(v.v_ref_mps) || v.v_ref_mps > 1e3) {
-      return {"vines.v_ref_mps", "must be in (0, 1000]"};
-    }
-  }
+  // The law's own checks (eps, tau...).
+  ParamError law_error{"vines.law", "is not a known contact law"};
+  with_law(v.law, [&](auto law) { law_error = decltype(law)::check(v); });
+  if (!law_error.ok()) return law_error;
   if (!v.start_at_left_wall) {
     if (!std::isfinite(v.initial_position_m)) return {"vines.initial_position_m", "must be finite"};
   }

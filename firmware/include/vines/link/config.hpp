@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <initializer_list>
 
+#include "vines/contact_laws.hpp"
 #include "vines/link/wire.hpp"
 #include "vines/params.hpp"
 
@@ -116,7 +117,7 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
                     &v.initial_velocity_mps})
     *x = r.f64();
   const std::uint8_t law = r.u8();
-  if (law > static_cast<std::uint8_t>(ContactLaw::kRestitution)) return false;
+  if (law >= kContactLawCount) return false;
   v.law = static_cast<ContactLaw>(law);
   v.start_at_left_wall = r.u8() != 0;
   LoopParams& l = c->scene.loop;
