@@ -24,6 +24,18 @@ bool launched_by_mpirun() {
   return std::getenv("OMPI_COMM_WORLD_SIZE") != nullptr || std::getenv("PMI_SIZE") != nullptr;
 }
 
+// The numbers of a result, copied to or from its packed form.
+template <class From, class To>
+void copy_numbers(const From& from, To* to) {
+  to->contacts = from.contacts;
+  to->cap_hits = from.cap_hits;
+  to->x_r = from.x_r;
+  to->E_r = from.E_r;
+  to->peak_top = from.peak_top;
+  to->elastic_energy = from.elastic_energy;
+  to->residual = from.residual;
+}
+
 }  // namespace
 
 Mpi::Mpi() {
@@ -46,13 +58,7 @@ void Mpi::gather(std::vector<RunResult>* results) const {
     if (!r.done) continue;
     Packed p{};
     p.index = static_cast<std::int64_t>(i);
-    p.contacts = r.contacts;
-    p.cap_hits = r.cap_hits;
-    p.x_r = r.x_r;
-    p.E_r = r.E_r;
-    p.peak_top = r.peak_top;
-    p.elastic_energy = r.elastic_energy;
-    p.residual = r.residual;
+    copy_numbers(r, &p);
     std::strncpy(p.device, r.device.c_str(), sizeof p.device - 1);
     std::strncpy(p.error, r.error.c_str(), sizeof p.error - 1);
     mine.push_back(p);
@@ -74,13 +80,7 @@ void Mpi::gather(std::vector<RunResult>* results) const {
   for (const Packed& p : all) {
     RunResult& r = (*results)[static_cast<std::size_t>(p.index)];
     r.done = true;
-    r.contacts = p.contacts;
-    r.cap_hits = p.cap_hits;
-    r.x_r = p.x_r;
-    r.E_r = p.E_r;
-    r.peak_top = p.peak_top;
-    r.elastic_energy = p.elastic_energy;
-    r.residual = p.residual;
+    copy_numbers(p, &r);
     r.device = p.device;
     r.error = p.error;
   }

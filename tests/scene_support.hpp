@@ -1,0 +1,53 @@
+// Shared by the scene tests (test_scene*.cpp): the shipped scenes' folder, a
+// valid VI NES scene to edit, and the refusal of a scene text.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <initializer_list>
+#include <string>
+
+#include "sim_host/scene.hpp"
+
+namespace vines::scene_test {
+
+using vines::ContactLaw;
+using vines::DampingRule;
+using vines::DeviceKind;
+using vines::host::load_scene;
+using vines::host::parse_scene;
+using vines::host::resolve_record_path;
+using vines::host::Scene;
+using vines::host::SceneError;
+namespace fs = std::filesystem;
+
+inline const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+inline const char* kElCentro = "elcentro_1940_ns_2688pts_dt002_time_g.dat";
+
+// A valid VI NES scene; tests append or replace parts of it.
+inline const std::string kBase = R"(
+[device]
+kind = "vines"
+[record]
+path = "elcentro_1940_ns_2688pts_dt002_time_g.dat"
+)";
+
+// The SceneError message of parsing `text` ("" if it parses).
+inline std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "bad.toml");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Expects `text` to be refused with a message containing every part.
+inline void expect_refused(const std::string& text, std::initializer_list<const char*> parts) {
+  const std::string msg = error_of(text);
+  ASSERT_FALSE(msg.empty()) << "accepted:\n" << text;
+  for (const char* p : parts) EXPECT_NE(msg.find(p), std::string::npos) << msg << "\nlacks: " << p;
+}
+
+}  // namespace vines::scene_test
