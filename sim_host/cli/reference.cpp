@@ -24,25 +24,23 @@ int reference(ReferenceArgs a) {
   const Scene scene = load_scene(a.scene_path);
   std::string& out = a.out;
   if (out.empty()) out = "data/reference/" + scene.name + ".json";
-  const nlohmann::json j = reference::reference_report(scene, a.rtol);
+  const reference::ReferenceReport rep = reference::reference_report(scene, a.rtol);
   const std::filesystem::path file(out);
   std::error_code ec;
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
   std::ofstream f(file);
-  if (ec || !(f << j.dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
+  if (ec || !(f << rep.to_json().dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
   if (!a.quiet) {
-    const nlohmann::json& c = j["convergence"];
-    std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), j["rtol"].get<double>(),
-                j["steps"].get<long long>(), j["wall_s"].get<double>());
-    std::printf("  peak top displacement %.12f m at t = %.6f s; E_e %.10e J s; contacts %d\n",
-                j["peak_top_displacement_m"].get<double>(), j["t_peak_top_s"].get<double>(),
-                j["elastic_energy_Js"].get<double>(), j["contacts"].get<int>());
-    std::printf("  x_r = %.4f %%   E_r = %.4f %%   (bare peak %.12f m)\n", 100 * j["x_r"].get<double>(),
-                100 * j["E_r"].get<double>(), j["bare"]["peak_top_displacement_m"].get<double>());
+    const reference::Result& r = rep.run;
+    std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), rep.rtol, r.steps, r.wall_s);
+    std::printf("  peak top displacement %.12f m at t = %.6f s; E_e %.10e J s; contacts %d\n", r.peak_top,
+                r.t_peak_top, r.elastic_energy, r.contacts);
+    std::printf("  x_r = %.4f %%   E_r = %.4f %%   (bare peak %.12f m)\n", 100 * rep.x_r(), 100 * rep.E_r(),
+                rep.bare.peak_top);
     std::printf("  convergence vs rtol %.0e: peak %.1e, E_e %.1e (relative), contacts %s; written to %s\n",
-                c["rtol_coarse"].get<double>(), c["peak_rel_diff"].get<double>(),
-                c["elastic_energy_rel_diff"].get<double>(), c["contacts_equal"].get<bool>() ? "equal" : "DIFFER",
-                out.c_str());
+                rep.rtol_coarse, reference::rel_diff(rep.coarse.peak_top, r.peak_top),
+                reference::rel_diff(rep.coarse.elastic_energy, r.elastic_energy),
+                rep.coarse.contacts == r.contacts ? "equal" : "DIFFER", out.c_str());
   }
   return kOk;
 }

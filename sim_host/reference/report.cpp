@@ -4,15 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "sim_host/reference/truth.hpp"
-#include "sim_host/run.hpp"
-
 namespace vines::host::reference {
 namespace {
 
 using nlohmann::json;
-
-double rel_diff(double a, double b) { return b != 0.0 ? std::fabs(a - b) / std::fabs(b) : std::fabs(a - b); }
 
 // Largest shift of a contact start between two runs (null if the counts differ).
 json start_shift(const Result& a, const Result& b) {
@@ -51,7 +46,7 @@ std::vector<double> knots(const Excitation& ex, double* rate) {
 
 }  // namespace
 
-json reference_report(const Scene& scene, double rtol) {
+ReferenceReport reference_report(const Scene& scene, double rtol) {
   const Excitation ex = load_excitation(scene, "");
   const SceneParams& p = scene.params;
   Options fine;
@@ -63,28 +58,45 @@ json reference_report(const Scene& scene, double rtol) {
       throw std::runtime_error(scene.path + ": " + e.what());
     }
   };
-  const Result r = run(p, fine);
-  const double rtol_used = rtol > 0.0 ? rtol : 1e-15;
+  ReferenceReport rep;
+  rep.scene = scene.name;
+  rep.scene_file = scene.path;
+  rep.record = {scene.record.path, ex.record.dt_s, ex.record.accel_mps2.size(), ex.record.pga_mps2(),
+                static_cast<double>(ex.samples.size() - 1) / ex.rate_hz};
+  rep.sample_rate_hz = ex.rate_hz;
+  // The scene at the tolerance and at 100 times it; its bare frame the same.
+  rep.run = run(p, fine);
+  rep.rtol = rtol > 0.0 ? rtol : 1e-15;
   Options coarse_opt = fine;
-  coarse_opt.rtol = 100.0 * rtol_used;
-  const Result coarse = run(p, coarse_opt);
+  coarse_opt.rtol = 100.0 * rep.rtol;
+  rep.rtol_coarse = coarse_opt.rtol;
+  rep.coarse = run(p, coarse_opt);
   const bool has_device = p.device.kind != DeviceKind::kNone;
   SceneParams pb = p;
   pb.device.kind = DeviceKind::kNone;
-  const Result bare = has_device ? run(pb, fine) : r;
-  const Result bare_coarse = has_device ? run(pb, coarse_opt) : coarse;
+  rep.bare = has_device ? run(pb, fine) : rep.run;
+  rep.bare_coarse = has_device ? run(pb, coarse_opt) : rep.coarse;
+  // At the sensor rate the linear scenes take one step per sample at both
+  // tolerances; the knot run is the check that moves their steps.
+  double knot_rate = 0.0;
+  const std::vector<double> k = knots(ex, &knot_rate);
+  if (!k.empty()) rep.knots = KnotRun{knot_rate, integrate(p, k, knot_rate, Method::kReference, fine)};
+  return rep;
+}
 
+json ReferenceReport::to_json() const {
+  const Result& r = run;
   json j;
-  j["scene"] = scene.name;
-  j["scene_file"] = scene.path;
-  j["record"] = {{"path", scene.record.path},  // as the scene names it (resolved at run time)
-                 {"dt_s", ex.record.dt_s},
-                 {"points", ex.record.accel_mps2.size()},
-                 {"pga_mps2", ex.record.pga_mps2()},
-                 {"sample_rate_hz", ex.rate_hz},
-                 {"simulated_s", static_cast<double>(ex.samples.size() - 1) / ex.rate_hz}};
+  j["scene"] = scene;
+  j["scene_file"] = scene_file;
+  j["record"] = {{"path", record.path},  // as the scene names it (resolved at run time)
+                 {"dt_s", record.dt_s},
+                 {"points", record.points},
+                 {"pga_mps2", record.pga_mps2},
+                 {"sample_rate_hz", sample_rate_hz},
+                 {"simulated_s", record.simulated_s}};
   j["method"] = method_name(Method::kReference);
-  j["rtol"] = rtol_used;
+  j["rtol"] = rtol;
   j["peak_top_displacement_m"] = r.peak_top;
   j["t_peak_top_s"] = r.t_peak_top;
   j["elastic_energy_Js"] = r.elastic_energy;
@@ -94,19 +106,15 @@ json reference_report(const Scene& scene, double rtol) {
   j["bare"] = {{"peak_top_displacement_m", bare.peak_top},
                {"t_peak_top_s", bare.t_peak_top},
                {"elastic_energy_Js", bare.elastic_energy}};
-  j["x_r"] = (bare.peak_top - r.peak_top) / bare.peak_top;
-  j["E_r"] = (bare.elastic_energy - r.elastic_energy) / bare.elastic_energy;
-  j["convergence"] = convergence(r, coarse, coarse_opt.rtol);
-  j["convergence"]["bare"] = convergence(bare, bare_coarse, coarse_opt.rtol);
-  // At the sensor rate the linear scenes take one step per sample at both
-  // tolerances; the knot run is the check that moves their steps.
-  double knot_rate = 0.0;
-  const std::vector<double> k = knots(ex, &knot_rate);
-  if (k.empty()) {
+  j["x_r"] = x_r();
+  j["E_r"] = E_r();
+  j["convergence"] = convergence(r, coarse, rtol_coarse);
+  j["convergence"]["bare"] = convergence(bare, bare_coarse, rtol_coarse);
+  if (!knots) {
     j["convergence"]["knots"] = nullptr;
   } else {
-    const Result rk = integrate(p, k, knot_rate, Method::kReference, fine);
-    j["convergence"]["knots"] = {{"sample_rate_hz", knot_rate},
+    const Result& rk = knots->result;
+    j["convergence"]["knots"] = {{"sample_rate_hz", knots->sample_rate_hz},
                                  {"steps", rk.steps},
                                  {"peak_rel_diff", rel_diff(rk.peak_top, r.peak_top)},
                                  {"elastic_energy_rel_diff", rel_diff(rk.elastic_energy, r.elastic_energy)},
