@@ -88,6 +88,8 @@ TEST(Stress, RestitutionImpactsNeverLeaveTheParticleBeyondAWall) {
     const Scene s = load_scene(std::string(VINES_TEST_DATA_DIR) + "/restitution_tunnelling/" + name + ".toml");
     const Excitation ex = load_excitation(s, "");
     auto eng = make_engine(s.params, s.scalar);
+    // The cases' frames are in the release build (VINES_STRESS_STORY_COUNTS).
+    ASSERT_NE(eng, nullptr) << missing_engine(s.params, s.scalar);
     ASSERT_TRUE(eng->build(s.params).ok());
     eng->init(ex.samples[0]);
     double deepest = 0;
