@@ -1,18 +1,10 @@
 #include "sim_host/csv.hpp"
 
-#include <cerrno>
-#include <cstring>
-#include <stdexcept>
+#include <cstdio>
 
 namespace vines::host {
 
-CsvWriter::CsvWriter(const std::string& path) : path_(path), file_(std::fopen(path.c_str(), "w")) {
-  if (file_ == nullptr) throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
-}
-
-CsvWriter::~CsvWriter() {
-  if (file_ != nullptr) std::fclose(file_);  // unwinding: the error in flight is the one to report
-}
+CsvWriter::CsvWriter(const std::string& path) : file_(path) {}
 
 // ---- cells ----
 CsvWriter& CsvWriter::text(const std::string& s) {
@@ -50,15 +42,9 @@ void CsvWriter::end_row() {
 }
 
 // ---- checked output ----
-void CsvWriter::close() {
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (failed_ || !closed) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
-}
+void CsvWriter::close() { file_.commit(); }
 
-void CsvWriter::put(const char* s, std::size_t n) {
-  if (std::fwrite(s, 1, n, file_) != n) failed_ = true;
-}
+void CsvWriter::put(const char* s, std::size_t n) { file_.write(s, n); }
 
 void CsvWriter::separate() {
   if (!first_) put(",", 1);

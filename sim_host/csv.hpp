@@ -2,19 +2,20 @@
 // timeseries.csv, bench --csv, hil --csv): comma-separated cells, one row a line; a
 // text cell is quoted when it holds a comma, a quote or a line break (quotes
 // doubled, RFC 4180), or always with quoted(); numbers in a printf format.
-// Writes are checked: a file that cannot be opened or written throws a
-// std::runtime_error naming it.
+// Writes are checked and atomic (sim_host/output.hpp): the file appears, whole,
+// at close(); a write that fails throws a std::runtime_error naming the file
+// and the reason, and a writer dropped before close() leaves the old file as it was.
 #pragma once
 
-#include <cstdio>
 #include <string>
+
+#include "sim_host/output.hpp"
 
 namespace vines::host {
 
 class CsvWriter {
  public:
-  explicit CsvWriter(const std::string& path);  // creates or truncates the file
-  ~CsvWriter();
+  explicit CsvWriter(const std::string& path);  // starts the file's temporary copy
   CsvWriter(const CsvWriter&) = delete;
   CsvWriter& operator=(const CsvWriter&) = delete;
 
@@ -25,17 +26,15 @@ class CsvWriter {
   CsvWriter& integer(long long v);
   CsvWriter& empty();                       // an empty cell
   void end_row();
-  // Flushes and closes; throws if anything could not be written.
+  // Flushes, closes and puts the file in place; throws if anything could not be written.
   void close();
 
  private:
   void put(const char* s, std::size_t n);
   void separate();
 
-  std::string path_;
-  std::FILE* file_ = nullptr;
+  AtomicFile file_;
   bool first_ = true;  // no cell yet in this row
-  bool failed_ = false;
 };
 
 }  // namespace vines::host

@@ -1,0 +1,214 @@
+// sim_host/output.hpp: atomic checked writes, safe folder names, output folders
+// owned by their command.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "sim_host/csv.hpp"
+#include "sim_host/output.hpp"
+
+namespace fs = std::filesystem;
+using vines::host::AtomicFile;
+using vines::host::CsvWriter;
+using vines::host::OutputDir;
+using vines::host::safe_file_name;
+using vines::host::write_file_atomic;
+
+namespace {
+
+// A fresh empty folder per test, removed after it.
+class OutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("vines_test_output_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::set<std::string> names() const {
+    std::set<std::string> s;
+    for (const auto& e : fs::directory_iterator(dir_)) s.insert(e.path().filename().string());
+    return s;
+  }
+  fs::path dir_;
+};
+
+std::string read(const std::string& path) {
+  std::ostringstream s;
+  s << std::ifstream(path).rdbuf();
+  return s.str();
+}
+
+// Files larger than `bytes` cannot be written (EFBIG) while it lives; SIGXFSZ ignored.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    old_signal_ = std::signal(SIGXFSZ, SIG_IGN);
+    ::getrlimit(RLIMIT_FSIZE, &old_);
+    rlimit lim = old_;
+    lim.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &old_);
+    std::signal(SIGXFSZ, old_signal_);
+  }
+
+ private:
+  rlimit old_{};
+  void (*old_signal_)(int);
+};
+
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// ---- atomic writes ----
+TEST_F(OutputTest, AtomicWriteReplacesTheFileWhole) {
+  write_file_atomic(path("a.json"), "old\n");
+  write_file_atomic(path("a.json"), "new\n");
+  EXPECT_EQ(read(path("a.json")), "new\n");
+  EXPECT_EQ(names(), std::set<std::string>{"a.json"});  // no temporary file left
+}
+
+TEST_F(OutputTest, FailedWriteLeavesTheOldFileAndNoTemporaryFile) {
+  write_file_atomic(path("a.json"), "old\n");
+  std::string msg;
+  {
+    const FileSizeLimit limit(1024);
+    msg = message_of([&] { write_file_atomic(path("a.json"), std::string(1 << 20, 'x')); });
+  }
+  EXPECT_EQ(msg, path("a.json") + ": cannot write: File too large");
+  EXPECT_EQ(read(path("a.json")), "old\n");
+  EXPECT_EQ(names(), std::set<std::string>{"a.json"});
+}
+
+TEST_F(OutputTest, UncommittedFileIsDroppedAndTheTargetKept) {
+  write_file_atomic(path("a.csv"), "old\n");
+  {
+    CsvWriter csv(path("a.csv"));
+    csv.raw("half").end_row();  // an exception before close(): nothing replaced
+  }
+  EXPECT_EQ(read(path("a.csv")), "old\n");
+  EXPECT_EQ(names(), std::set<std::string>{"a.csv"});
+  {
+    CsvWriter csv(path("a.csv"));
+    csv.raw("x").integer(1).end_row();
+    csv.close();
+  }
+  EXPECT_EQ(read(path("a.csv")), "x,1\n");
+}
+
+TEST_F(OutputTest, CsvWriterFailsWithThePathAndTheReason) {
+  std::string msg;
+  {
+    const FileSizeLimit limit(1024);
+    msg = message_of([&] {
+      CsvWriter csv(path("big.csv"));
+      for (int i = 0; i < 100000; ++i) csv.integer(i).end_row();
+      csv.close();
+    });
+  }
+  EXPECT_EQ(msg, path("big.csv") + ": cannot write: File too large");
+  EXPECT_TRUE(names().empty());
+}
+
+TEST_F(OutputTest, MissingFolderIsNamedWithTheReason) {
+  EXPECT_EQ(message_of([&] { write_file_atomic(path("no/such/a.json"), "x"); }),
+            path("no/such/a.json") + ": cannot write: No such file or directory");
+}
+
+TEST_F(OutputTest, SymbolicLinkStaysAndItsFileIsReplaced) {
+  write_file_atomic(path("real.csv"), "old\n");
+  fs::create_symlink("real.csv", dir_ / "link.csv");
+  write_file_atomic(path("link.csv"), "new\n");
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_EQ(read(path("real.csv")), "new\n");
+}
+
+TEST(Output, DeviceIsWrittenInPlace) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  write_file_atomic("/dev/null", "x");
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  EXPECT_EQ(message_of([] { write_file_atomic("/dev/full", "x"); }),
+            "/dev/full: cannot write: No space left on device");
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+}
+
+// ---- safe names ----
+TEST(Output, SafeFileNames) {
+  EXPECT_EQ(safe_file_name("elcentro_vines-2.b"), "elcentro_vines-2.b");
+  EXPECT_EQ(safe_file_name("../../evil"), "___.._evil");
+  EXPECT_EQ(safe_file_name(".."), "__");
+  EXPECT_EQ(safe_file_name("."), "_");
+  EXPECT_EQ(safe_file_name(""), "_");
+  EXPECT_EQ(safe_file_name(".hidden"), "_hidden");
+  EXPECT_EQ(safe_file_name("a\nb\tc\x01 d/e\\f"), "a_b_c__d_e_f");
+  EXPECT_EQ(safe_file_name("K\xc5\x8d" "be"), "K__be");
+  EXPECT_EQ(safe_file_name(std::string(5000, 'a')).size(), 100u);
+}
+
+// ---- output folders ----
+TEST_F(OutputTest, FolderIsCreated) {
+  const OutputDir out(path("new/run"), "vines run", {"summary.json"});
+  EXPECT_TRUE(fs::is_directory(dir_ / "new" / "run"));
+  EXPECT_EQ(out.file("summary.json"), path("new/run") + "/summary.json");
+}
+
+TEST_F(OutputTest, FinishRemovesStaleFilesOfTheCommand) {
+  write_file_atomic(path("summary.json"), "old");
+  write_file_atomic(path("timeseries.csv"), "old");
+  write_file_atomic(path(".timeseries.csv.tmp-abc123"), "left by a kill");
+  const OutputDir out(dir_.string(), "vines run", {"summary.json", "timeseries.csv"});
+  write_file_atomic(out.file("summary.json"), "new");
+  out.finish({"summary.json"});
+  EXPECT_EQ(names(), std::set<std::string>{"summary.json"});
+  EXPECT_EQ(read(path("summary.json")), "new");
+}
+
+TEST_F(OutputTest, PatternsNameTheCommandsFiles) {
+  write_file_atomic(path("case_7.toml"), "old");
+  write_file_atomic(path("case_7_record.txt"), "old");
+  const OutputDir out(dir_.string(), "vines stress", {"stress.json", "case_*.toml", "case_*_record.txt"});
+  write_file_atomic(out.file("case_9.toml"), "new");
+  out.finish({"case_9.toml"});
+  EXPECT_EQ(names(), std::set<std::string>{"case_9.toml"});
+}
+
+TEST_F(OutputTest, FolderWithForeignFilesIsRefusedAndLeftAlone) {
+  write_file_atomic(path("summary.json"), "old");
+  write_file_atomic(path("notes.txt"), "mine");
+  fs::create_directories(dir_ / "plots");
+  const std::string msg = message_of([&] { OutputDir(dir_.string(), "vines run", {"summary.json"}); });
+  EXPECT_EQ(msg, dir_.string() + ": holds files vines run does not write (notes.txt, plots/): give an empty or new "
+                                 "folder, or one of vines run's own");
+  EXPECT_EQ(names(), (std::set<std::string>{"summary.json", "notes.txt", "plots"}));
+}
+
+TEST_F(OutputTest, EmptyPathAndFileInTheWayAreRefused) {
+  EXPECT_EQ(message_of([] { OutputDir("", "vines run", {"summary.json"}); }),
+            "vines run: the output folder is an empty path");
+  write_file_atomic(path("file"), "x");
+  EXPECT_EQ(message_of([&] { OutputDir(path("file"), "vines run", {"summary.json"}); }),
+            path("file") + ": cannot create: a file of that name exists");
+  const std::string below = message_of([&] { OutputDir(path("file/sub"), "vines run", {"summary.json"}); });
+  EXPECT_EQ(below.rfind(path("file/sub") + ": cannot create: ", 0), 0u) << below;
+}
