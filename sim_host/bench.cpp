@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "sim_host/build_engine.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/run.hpp"
 
@@ -139,7 +140,7 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
 
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);
-  const fs::path file = dir / (scene.name + ".json");
+  const fs::path file = dir / (safe_file_name(scene.name) + ".json");  // as vines reference names it
   Truth t;
   if (!fs::is_regular_file(file)) return t;
   try {

@@ -4,12 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/csv.hpp"
 #include "sim_host/names.hpp"
+#include "sim_host/output.hpp"
 
 namespace vines::host {
 namespace {
@@ -180,15 +180,17 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   if (has_device) r.bare = bare.totals;
   r.wall_s = dev.wall_s;
 
+  // The run's folder: timeseries.csv, then summary.json (the file that says the
+  // run is complete) last; a timeseries.csv of an earlier run is removed.
   if (!opt.out_dir.empty()) {
-    const fs::path dir(opt.out_dir);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw std::runtime_error(opt.out_dir + ": cannot create: " + ec.message());
-    std::ofstream out(dir / "summary.json");
-    out << r.to_json().dump(2) << '\n';
-    if (!out) throw std::runtime_error((dir / "summary.json").string() + ": cannot write");
-    if (series) write_timeseries(dir / "timeseries.csv", scene, dev, has_device ? &bare : nullptr);
+    const OutputDir out(opt.out_dir, "vines run", {"summary.json", "timeseries.csv"});
+    std::vector<std::string> written{"summary.json"};
+    if (series) {
+      write_timeseries(out.file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
+      written.push_back("timeseries.csv");
+    }
+    write_file_atomic(out.file("summary.json"), r.to_json().dump(2) + '\n');
+    out.finish(written);
   }
   return r;
 }

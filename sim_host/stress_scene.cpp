@@ -6,11 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "sim_host/engine.hpp"
 #include "sim_host/names.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/stress.hpp"
 
@@ -261,10 +262,10 @@ std::string write_case_scene(const StressCase& c, const std::vector<StressRecord
   if (ec) throw std::runtime_error(dir + ": cannot create: " + ec.message());
   // The window, scaled, one value a line in m/s^2 (17 digits: bit for bit).
   {
-    std::ofstream rec(fs::path(dir) / (stem + "_record.txt"));
+    std::string rec;
     const hal::Record& r = records[static_cast<std::size_t>(c.record)].record;
-    for (int i = 0; i < c.window_samples; ++i) rec << num(r.accel_mps2[c.first_sample + i] * c.pga_scale) << '\n';
-    if (!rec) throw std::runtime_error(dir + "/" + stem + "_record.txt: cannot write");
+    for (int i = 0; i < c.window_samples; ++i) rec += num(r.accel_mps2[c.first_sample + i] * c.pga_scale) + '\n';
+    write_file_atomic((fs::path(dir) / (stem + "_record.txt")).string(), rec);
   }
   // The scene as a toml++ table (doubles print in full: the same numbers back).
   auto list = [](const auto* v, int n) {
@@ -300,10 +301,10 @@ std::string write_case_scene(const StressCase& c, const std::vector<StressRecord
     scene.insert("vines", vines);
   }
   const fs::path path = fs::path(dir) / (stem + ".toml");
-  std::ofstream out(path);
-  out << "# vines stress --seed " << c.seed << " --case " << c.index << "\n# " << case_json(c, records).dump()
-      << "\n" << scene << '\n';
-  if (!out) throw std::runtime_error(path.string() + ": cannot write");
+  std::ostringstream text;
+  text << "# vines stress --seed " << c.seed << " --case " << c.index << "\n# " << case_json(c, records).dump()
+       << "\n" << scene << '\n';
+  write_file_atomic(path.string(), text.str());
   return path.string();
 }
 

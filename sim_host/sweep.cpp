@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
@@ -17,6 +16,7 @@
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/csv.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/parallel.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene_toml.hpp"
@@ -351,10 +351,7 @@ SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan
   }
   for (int i = 0; i < static_cast<int>(spec.studies.size()); ++i)
     s.studies.push_back(summarize_study(spec, i, plan, results));
-  const fs::path file = fs::path(out_dir) / "summary.json";
-  std::ofstream out(file);
-  out << s.to_json().dump(2) << '\n';
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  write_file_atomic((fs::path(out_dir) / "summary.json").string(), s.to_json().dump(2) + '\n');
   return s;
 }
 

@@ -107,7 +107,7 @@ void add_bench(CLI::App& vines) {
                 "also compute the scene's per-floor peaks and energy ledger (default: only what the table needs, "
                 "as a study run does)");
   cmd->add_flag("--json", a->as_json, "print JSON: one object for a single line, else {\"lines\": [...]}");
-  cmd->add_option("--csv", a->csv, "also write the lines as CSV")->type_name("FILE");
+  cmd->add_option("--csv", a->csv, "also write the lines as CSV")->type_name("FILE")->check(non_empty_path());
 }
 
 }  // namespace vines::cli

@@ -105,6 +105,11 @@ CLI::Validator positive_up_to(double hi) {
       "");
 }
 
+CLI::Validator non_empty_path() {
+  return CLI::Validator([](std::string& path) { return path.empty() ? "an empty path names no file or folder" : ""; },
+                        "");
+}
+
 const std::atomic<bool>* stop_on_interrupt() {
   std::signal(SIGINT, [](int) {
     g_stop = true;

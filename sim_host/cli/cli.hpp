@@ -38,6 +38,8 @@ CLI::Option* add_number_list(CLI::App& cmd, const std::string& name, std::vector
 // most hi. (CLI::Range lets NaN through.)
 CLI::Validator number_in(double lo, double hi);
 CLI::Validator positive_up_to(double hi);
+// Check of a file or folder option (--out, --csv): not an empty path.
+CLI::Validator non_empty_path();
 
 // Ctrl-C from now on sets the returned flag (a run under way stops at its next
 // check and keeps what finished, status kInterrupted); a second Ctrl-C ends

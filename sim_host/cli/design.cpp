@@ -1,16 +1,14 @@
 // `vines design SCENE.toml --optimize NAME`: the best value of one design parameter.
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <utility>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/design.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/scene.hpp"
 
 namespace vines::cli {
@@ -18,7 +16,7 @@ namespace {
 
 struct DesignArgs {
   host::DesignOptions opt;
-  std::string name, out_dir;  // out_dir "": out/design_<scene name>
+  std::string name, out_dir;  // out_dir not given: out/design_<scene name>
 };
 
 int design(DesignArgs a) {
@@ -27,7 +25,8 @@ int design(DesignArgs a) {
   if (!design_parameter(a.name, &opt))
     throw CLI::ValidationError("--optimize", a.name + ": unknown (a scene key needs --range)");
   const Scene scene = load_scene(opt.scene_path);
-  if (a.out_dir.empty()) a.out_dir = "out/design_" + scene.name;
+  if (a.out_dir.empty()) a.out_dir = "out/design_" + safe_file_name(scene.name);
+  const OutputDir out(a.out_dir, "vines design", {"design.json"});  // claimed before the search
   opt.stop = stop_on_interrupt();
   DesignResult r;
   try {
@@ -36,11 +35,8 @@ int design(DesignArgs a) {
     std::fprintf(stderr, "vines design: interrupted; nothing written\n");
     return kInterrupted;
   }
-  std::filesystem::create_directories(a.out_dir);
-  const std::filesystem::path file = std::filesystem::path(a.out_dir) / "design.json";
-  std::ofstream out(file);
-  out << r.to_json().dump(2) << '\n';
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  write_file_atomic(out.file("design.json"), r.to_json().dump(2) + '\n');
+  out.finish({"design.json"});
   std::printf("design %s: best %s = %.6g, %s %s = %.2f %% (%zu evaluations; %s/design.json)\n", scene.name.c_str(),
               opt.key.c_str(), r.best_value, opt.objective.c_str(), opt.metric.c_str(), 100 * r.best_objective,
               r.evaluations.size(), a.out_dir.c_str());
@@ -92,7 +88,10 @@ void add_design(CLI::App& vines) {
   cmd->add_option("--threads", opt.threads, "worker threads (default: all cores)")
       ->type_name("N")
       ->check(number_in(1, 1000));
-  cmd->add_option("--out", a->out_dir, "writes DIR/design.json (default: out/design_<scene name>)")->type_name("DIR");
+  cmd->add_option("--out", a->out_dir,
+                  "writes DIR/design.json; DIR new, empty or vines design's own (default: out/design_<scene name>)")
+      ->type_name("DIR")
+      ->check(non_empty_path());
 }
 
 }  // namespace vines::cli

@@ -122,7 +122,7 @@ void add_hil(CLI::App& vines) {
       ->type_name("S")
       ->check(number_in(1e-6, 1e6));
   cmd->add_flag("--json", a->as_json, "print one JSON object");
-  cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE");
+  cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
   cmd->add_option("--timeout", opt.timeout_s, "longest wait for the node (default 5, 60 with QEMU)")
       ->type_name("S")
       ->check(number_in(0.01, 3600));

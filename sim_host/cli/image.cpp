@@ -1,9 +1,6 @@
 // `vines image SCENE.toml --out FILE`: the model image a board loads.
-#include <cerrno>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -12,6 +9,7 @@
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/build_engine.hpp"
 #include "sim_host/names.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/scene.hpp"
 #include "vines/model_image.hpp"
 
@@ -31,19 +29,10 @@ int image(const ImageArgs& a) {
   const std::vector<std::uint8_t> img = build_engine(p, scalar, scene.path)->model_image();
   vines::image::HeaderInfo h;
   if (!vines::image::read_header(img.data(), img.size(), &h)) throw std::runtime_error("no image written");
-  // Checked writes: a short write or a failed close (disk full) is an error,
-  // and no partial image is left behind.
-  std::FILE* f = std::fopen(out.c_str(), "wb");
-  if (!f) throw std::runtime_error(out + ": cannot open for writing: " + std::strerror(errno));
-  const bool wrote = std::fwrite(img.data(), 1, img.size(), f) == img.size();
-  const int write_errno = errno;
-  const bool closed = std::fclose(f) == 0;
-  if (!wrote || !closed) {
-    const std::string why = std::strerror(wrote ? errno : write_errno);
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(out, ec)) std::remove(out.c_str());
-    throw std::runtime_error(out + ": cannot write: " + why);
-  }
+  // Checked and atomic: a failed write (disk full) leaves no partial image.
+  AtomicFile f(out);
+  f.write(reinterpret_cast<const char*>(img.data()), img.size());
+  f.commit();
   std::string device = device_name(p.device.kind);
   if (p.device.kind == vines::DeviceKind::kVines) device += std::string(" (") + law_name(p.device.vines.law) + ")";
   std::printf("image %s: %zu bytes, version %u, %s, %u stories, %s, CRC 0x%08x; written to %s\n",
@@ -68,7 +57,7 @@ void add_image(CLI::App& vines) {
   cmd->add_option("--out", a->out, "the image file to write")
       ->type_name("FILE")
       ->required()
-      ->check(CLI::Validator([](std::string& f) { return f.empty() ? "needs a file name" : ""; }, ""));
+      ->check(non_empty_path());
 }
 
 }  // namespace vines::cli

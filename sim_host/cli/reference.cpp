@@ -1,12 +1,12 @@
 // `vines reference SCENE.toml`: the converged reference of a scene (data/reference/).
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/scene.hpp"
 
@@ -14,7 +14,7 @@ namespace vines::cli {
 namespace {
 
 struct ReferenceArgs {
-  std::string scene_path, out;  // out "": data/reference/<scene name>.json
+  std::string scene_path, out;  // out not given: data/reference/<scene name>.json
   double rtol = 0;              // 0: the default
   bool quiet = false;
 };
@@ -23,13 +23,14 @@ int reference(ReferenceArgs a) {
   using namespace vines::host;
   const Scene scene = load_scene(a.scene_path);
   std::string& out = a.out;
-  if (out.empty()) out = "data/reference/" + scene.name + ".json";
+  if (out.empty()) out = "data/reference/" + safe_file_name(scene.name) + ".json";
   const reference::ReferenceReport rep = reference::reference_report(scene, a.rtol);
-  const std::filesystem::path file(out);
+  // The file's folder made if missing, then the file written atomically.
+  const std::filesystem::path dir = std::filesystem::path(out).parent_path();
   std::error_code ec;
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-  std::ofstream f(file);
-  if (ec || !(f << rep.to_json().dump(2) << '\n')) throw std::runtime_error(out + ": cannot write");
+  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir.string() + ": cannot create: " + ec.message());
+  write_file_atomic(out, rep.to_json().dump(2) + '\n');
   if (!a.quiet) {
     const reference::Result& r = rep.run;
     std::printf("reference %s: rtol %.0e, %lld steps, %.2f s\n", scene.name.c_str(), rep.rtol, r.steps, r.wall_s);
@@ -61,7 +62,9 @@ void add_reference(CLI::App& vines) {
                   "repeats every run at 100 R")
       ->type_name("R")
       ->check(number_in(1e-17, 1e-4));
-  cmd->add_option("--out", a->out, "JSON output (default: data/reference/<scene name>.json)")->type_name("FILE");
+  cmd->add_option("--out", a->out, "JSON output (default: data/reference/<scene name>.json)")
+      ->type_name("FILE")
+      ->check(non_empty_path());
   cmd->add_flag("--quiet", a->quiet, "print nothing but errors");
 }
 

@@ -5,6 +5,7 @@
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/names.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 
@@ -14,14 +15,14 @@ namespace {
 struct RunArgs {
   std::string scene_path;
   host::RunOptions opt;
-  const CLI::Option* out = nullptr;  // --out, given (even empty: write nothing) or not
+  const CLI::Option* out = nullptr;  // --out, given or not
 };
 
 int run(RunArgs a) {
   using namespace vines::host;
   RunOptions& opt = a.opt;
   const Scene scene = load_scene(a.scene_path);
-  if (a.out->count() == 0) opt.out_dir = "out/" + scene.name;
+  if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(scene.name);
   const RunReport r = run_scene(scene, opt);
   const vines::SceneParams& p = scene.params;
   const Counters& k = r.totals.count;
@@ -71,7 +72,11 @@ void add_run(CLI::App& vines) {
                   "use this ground-motion file instead of the scene's [record] path (format read from the file: "
                   "PEER AT2 or columns; the scene's units, column and scale apply to columns)")
       ->type_name("PATH");
-  a->out = cmd->add_option("--out", a->opt.out_dir, "output folder (default: out/<scene name>)")->type_name("DIR");
+  a->out = cmd->add_option("--out", a->opt.out_dir,
+                           "output folder: new, empty or vines run's own; its files this run does not write are "
+                           "removed (default: out/<scene name>)")
+               ->type_name("DIR")
+               ->check(non_empty_path());
   cmd->add_flag("--quiet", a->opt.quiet, "print nothing but errors");
 }
 

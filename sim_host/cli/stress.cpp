@@ -2,16 +2,15 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <limits>
 #include <memory>
-#include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/names.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/parallel.hpp"
 #include "sim_host/stress.hpp"
 
@@ -82,30 +81,44 @@ int stress(const StressArgs& a) {
   using namespace vines::host;
   const StressOptions& opt = a.opt;
   const std::vector<StressRecord> records = load_stress_records();
+  // --out: the folder is claimed before the runs; the files written are noted
+  // so that finish() removes those of an earlier run.
+  std::optional<OutputDir> out;
+  if (!a.out_dir.empty())
+    out.emplace(a.out_dir, "vines stress",
+                std::vector<std::string>{"stress.json", "cases.jsonl", "case_*.toml", "case_*_record.txt"});
+  std::vector<std::string> written;
+  auto write_scene = [&](const StressCase& c) {
+    const std::string stem = "case_" + std::to_string(c.index);
+    written.insert(written.end(), {stem + ".toml", stem + "_record.txt"});
+    return write_case_scene(c, records, a.out_dir);
+  };
   // One case, in full.
   if (a.one_case >= 0) {
     const StressCase c = draw_case(opt.seed, a.one_case, records, opt.limits);
     const StressResult r = run_case(c, records);
     nlohmann::json j = case_report(c, r, records);
-    if (!a.out_dir.empty()) j["scene_file"] = write_case_scene(c, records, a.out_dir);
+    if (out) {
+      j["scene_file"] = write_scene(c);
+      out->finish(written);
+    }
     std::printf("%s\n", j.dump(a.as_json ? -1 : 2).c_str());
     return r.ok() ? kOk : kRefused;
   }
   const std::atomic<bool>* stop = stop_on_interrupt();
   const StressRun run = run_stress(opt, records, stop);
   StressSummary s = stress_summary(opt, run, a.worst);
-  // --out: the worst cases as scenes, stress.json, and every case run.
-  if (!a.out_dir.empty()) {
-    const std::filesystem::path dir(a.out_dir);
-    std::filesystem::create_directories(dir);
+  // --out: the worst cases as scenes, every case run, and stress.json last.
+  if (out) {
     for (CheckSummary& c : s.checks)
-      for (WorstCase& w : c.worst) w.scene_file = write_case_scene(run.cases[w.index], records, a.out_dir);
-    std::ofstream summary(dir / "stress.json");
-    summary << s.to_json(run, records).dump(2) << '\n';
-    std::ofstream cases(dir / "cases.jsonl");
+      for (WorstCase& w : c.worst) w.scene_file = write_scene(run.cases[w.index]);
+    std::string cases;
     for (std::size_t i = 0; i < run.results.size(); ++i)
-      if (run.results[i].done) cases << case_report(run.cases[i], run.results[i], records).dump() << '\n';
-    if (!summary || !cases) throw std::runtime_error(a.out_dir + ": cannot write stress.json / cases.jsonl");
+      if (run.results[i].done) cases += case_report(run.cases[i], run.results[i], records).dump() + '\n';
+    write_file_atomic(out->file("cases.jsonl"), cases);
+    write_file_atomic(out->file("stress.json"), s.to_json(run, records).dump(2) + '\n');
+    written.insert(written.end(), {"cases.jsonl", "stress.json"});
+    out->finish(written);
   }
   if (a.as_json) std::printf("%s\n", s.to_json(run, records).dump().c_str());
   else print_stress(s, run, records, map_threads(opt.threads));
@@ -140,8 +153,10 @@ void add_stress(CLI::App& vines) {
   cmd->add_flag("--json", a->as_json, "print one JSON object instead of tables");
   cmd->add_option("--out", a->out_dir,
                   "write DIR/stress.json, every case to DIR/cases.jsonl, and the listed cases as scenes "
-                  "DIR/case_K.toml (with their record windows) that `vines run` runs as they were")
-      ->type_name("DIR");
+                  "DIR/case_K.toml (with their record windows) that `vines run` runs as they were; DIR new, empty "
+                  "or vines stress's own, its case files of earlier runs removed")
+      ->type_name("DIR")
+      ->check(non_empty_path());
   cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress on stderr");
 }
 

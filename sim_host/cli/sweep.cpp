@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/output.hpp"
 #include "sim_host/sweep.hpp"
 #include "sim_host/sweep_mpi.hpp"
 
@@ -16,6 +17,7 @@ namespace {
 struct SweepArgs {
   std::string spec_path;
   host::SweepOptions opt;
+  const CLI::Option* out = nullptr;  // --out, given or not
 };
 
 int sweep(SweepArgs a) {
@@ -24,7 +26,10 @@ int sweep(SweepArgs a) {
   Mpi mpi;
   const SweepSpec spec = load_sweep(a.spec_path);
   const std::vector<RunPlan> plan = plan_runs(spec);
-  if (opt.out_dir.empty()) opt.out_dir = "out/" + std::filesystem::path(a.spec_path).stem().string();
+  if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(std::filesystem::path(a.spec_path).stem().string());
+  // The folder is claimed before the runs, by every rank (a refusal stops them
+  // all alike, none is left waiting for rank 0); rank 0 writes it.
+  const OutputDir out(opt.out_dir, "vines sweep", {"results.csv", "summary.json"});
   const std::atomic<bool>* stop = stop_on_interrupt();
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<RunResult> results =
@@ -33,6 +38,7 @@ int sweep(SweepArgs a) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
   const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
+  out.finish({"results.csv", "summary.json"});
   std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
               a.spec_path.c_str(), s.done, plan.size(), wall, s.runs_per_s(), mpi.size(), mpi.size() > 1 ? "s" : "",
               s.failed, opt.out_dir.c_str());
@@ -65,7 +71,10 @@ void add_sweep(CLI::App& vines) {
   cmd->add_option("SPEC.toml", a->spec_path,
                   "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
       ->required();
-  cmd->add_option("--out", a->opt.out_dir, "output folder (default: out/<spec name>)")->type_name("DIR");
+  a->out = cmd->add_option("--out", a->opt.out_dir,
+                           "output folder: new, empty or vines sweep's own (default: out/<spec name>)")
+               ->type_name("DIR")
+               ->check(non_empty_path());
   cmd->add_option("--threads", a->opt.threads, "worker threads (default: all cores; per rank under MPI)")
       ->type_name("N")
       ->check(number_in(1, 1024));
