@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# The commands' writes (sim_host/output.hpp) from the command line: a write
+# that fails (file-size limit: EFBIG, as a full disk) exits nonzero naming the
+# file and the reason, leaves no partial or temporary file and keeps the
+# previous results; a run owns its folder (stale files removed, foreign files
+# refused); --out "" is a usage error; a scene name cannot leave out/.
+# usage: output_cli_test.sh VINES_BINARY SOURCE_DIR
+set -euo pipefail
+vines=$1
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "output_cli: $*" >&2; exit 1; }
+
+# A short El Centro scene (2 s), and the same without timeseries.csv.
+sed -e 's/^units = "g"$/units = "g"\nduration_s = 2.0/' "$src/data/scenes/elcentro_vines.toml" > "$tmp/short.toml"
+{ cat "$tmp/short.toml"; echo "timeseries = false"; } > "$tmp/noseries.toml"  # [output] is the last table
+
+# Runs "$@" with files limited to 1 KiB (SIGXFSZ ignored: the write sees EFBIG);
+# expects a nonzero exit and "FILE: cannot write: File too large" on stderr.
+expect_efbig() {
+  local file=$1; shift
+  set +e
+  (trap '' XFSZ; ulimit -f 1; "$@" > "$tmp/out.txt" 2> "$tmp/err.txt")
+  local rc=$?
+  set -e
+  [[ $rc != 0 ]] || fail "$* exited 0 with a file-size limit"
+  grep -qF "$file: cannot write: File too large" "$tmp/err.txt" || fail "$*: no message naming $file: $(cat "$tmp/err.txt")"
+}
+# No temporary file left in folder $1.
+no_temp() { [[ -z $(find "$1" -name '.*.tmp-*') ]] || fail "temporary files left in $1: $(ls -A "$1")"; }
+
+# vines run: the earlier results stay whole.
+"$vines" run "$tmp/short.toml" --out "$tmp/run" --quiet
+cp -r "$tmp/run" "$tmp/run.before"
+expect_efbig "$tmp/run/timeseries.csv" "$vines" run "$tmp/short.toml" --out "$tmp/run" --quiet
+diff -r "$tmp/run.before" "$tmp/run" > /dev/null || fail "vines run: earlier results changed by a failed run"
+no_temp "$tmp/run"
+echo "run: write failure reported, earlier results intact"
+
+# A run without timeseries.csv removes the earlier one; a foreign file refuses the folder.
+"$vines" run "$tmp/noseries.toml" --out "$tmp/run" --quiet
+[[ -f $tmp/run/summary.json && ! -e $tmp/run/timeseries.csv ]] || fail "stale timeseries.csv kept: $(ls "$tmp/run")"
+touch "$tmp/run/notes.txt"
+set +e
+"$vines" run "$tmp/short.toml" --out "$tmp/run" --quiet 2> "$tmp/err.txt"
+rc=$?
+set -e
+[[ $rc == 1 ]] || fail "a folder with notes.txt: exit $rc, not 1"
+grep -q "notes.txt" "$tmp/err.txt" || fail "the refusal does not name notes.txt: $(cat "$tmp/err.txt")"
+[[ -f $tmp/run/notes.txt ]] || fail "notes.txt removed"
+echo "run: stale timeseries.csv removed, a folder with a foreign file refused"
+
+# vines sweep: results.csv fails; the earlier results.csv and summary.json stay whole.
+spec=$src/tests/data/mini_sweep.toml
+"$vines" sweep "$spec" --threads 2 --out "$tmp/sweep" --no-progress > /dev/null
+cp -r "$tmp/sweep" "$tmp/sweep.before"
+expect_efbig "$tmp/sweep/results.csv" "$vines" sweep "$spec" --threads 2 --out "$tmp/sweep" --no-progress
+diff -r "$tmp/sweep.before" "$tmp/sweep" > /dev/null || fail "vines sweep: earlier results changed by a failed sweep"
+no_temp "$tmp/sweep"
+echo "sweep: write failure reported, earlier results intact"
+
+# vines hil --csv: the same.
+hil=("$vines" hil "$tmp/short.toml" --duration 1 --csv "$tmp/hil.csv")
+"${hil[@]}" > /dev/null
+cp "$tmp/hil.csv" "$tmp/hil.before.csv"
+expect_efbig "$tmp/hil.csv" "${hil[@]}"
+cmp -s "$tmp/hil.before.csv" "$tmp/hil.csv" || fail "vines hil: earlier hil.csv changed by a failed write"
+no_temp "$tmp"
+echo "hil --csv: write failure reported, earlier file intact"
+
+# --out "": a usage error naming the option, nothing written.
+for cmd in "run $tmp/short.toml" "sweep $spec"; do
+  set +e
+  # shellcheck disable=SC2086
+  (cd "$tmp" && "$vines" $cmd --out "" 2> "$tmp/err.txt")
+  rc=$?
+  set -e
+  [[ $rc == 2 ]] || fail "vines $cmd --out \"\": exit $rc, not 2"
+  grep -q -- "--out" "$tmp/err.txt" || fail "vines $cmd --out \"\": message does not name --out"
+done
+echo "--out \"\": usage error"
+
+# A scene named ../../evil writes into out/, never beside it.
+mkdir -p "$tmp/w/c"
+sed 's/^name = .*/name = "..\/..\/evil"/' "$tmp/noseries.toml" > "$tmp/w/c/evil.toml"
+(cd "$tmp/w/c" && "$vines" run evil.toml --quiet)
+[[ -f $tmp/w/c/out/___.._evil/summary.json ]] || fail "no out/___.._evil/summary.json: $(find "$tmp/w")"
+[[ ! -e $tmp/evil && ! -e $tmp/w/evil ]] || fail "a scene name wrote outside out/"
+echo "name ../../evil: written to out/___.._evil/"
+echo "output_cli: ok"
