@@ -46,7 +46,8 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   }
   // Not a regular file (/dev/stdout, a pipe, /dev/full): written in place, checked.
   struct stat st {};
-  if (::stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+  const bool exists = ::stat(target.c_str(), &st) == 0;
+  if (exists && !S_ISREG(st.st_mode)) {
     file_ = std::fopen(target.c_str(), "wb");
     if (file_ == nullptr) throw cannot_write(path_, errno);
     return;
@@ -56,7 +57,8 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   const int fd = ::mkstemp(tmpl.data());
   if (fd < 0) throw cannot_write(path_, errno);
   tmp_ = tmpl;
-  ::fchmod(fd, new_file_mode());  // mkstemp's 0600 would hide the result from the group
+  // The replaced file's mode, or a new file's (mkstemp's 0600 would hide the result).
+  ::fchmod(fd, exists ? st.st_mode & 07777 : new_file_mode());
   file_ = ::fdopen(fd, "wb");
   if (file_ == nullptr) {
     const int err = errno;

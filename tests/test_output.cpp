@@ -2,6 +2,7 @@
 // owned by their command.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -87,6 +88,17 @@ TEST_F(OutputTest, AtomicWriteReplacesTheFileWhole) {
   write_file_atomic(path("a.json"), "new\n");
   EXPECT_EQ(read(path("a.json")), "new\n");
   EXPECT_EQ(names(), std::set<std::string>{"a.json"});  // no temporary file left
+}
+
+TEST_F(OutputTest, ReplacedFileKeepsItsModeAndNewFileFollowsTheUmask) {
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  write_file_atomic(path("new.json"), "x");
+  write_file_atomic(path("old.json"), "x");
+  fs::permissions(dir_ / "old.json", fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  write_file_atomic(path("old.json"), "y");
+  EXPECT_EQ(fs::status(dir_ / "new.json").permissions(), static_cast<fs::perms>(0666 & ~mask));
+  EXPECT_EQ(fs::status(dir_ / "old.json").permissions(), static_cast<fs::perms>(0640));
 }
 
 TEST_F(OutputTest, FailedWriteLeavesTheOldFileAndNoTemporaryFile) {
