@@ -154,7 +154,7 @@ void add_stress(CLI::App& vines) {
   cmd->add_option("--out", a->out_dir,
                   "write DIR/stress.json, every case to DIR/cases.jsonl, and the listed cases as scenes "
                   "DIR/case_K.toml (with their record windows) that `vines run` runs as they were; DIR new, empty "
-                  "or vines stress's own, its case files of earlier runs removed")
+                  "or vines stress's own (its files of an earlier run that this run does not write are removed)")
       ->type_name("DIR")
       ->check(non_empty_path());
   cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress on stderr");
