@@ -77,7 +77,8 @@ SweepSpec load_sweep(const std::string& path);
 std::vector<RunPlan> plan_runs(const SweepSpec& spec);
 
 // Runs plan[i] for every i with i % stride == offset (others stay not done),
-// on `threads` threads (parallel_map); stops taking new runs once *stop is set.
+// on `threads` threads (parallel_map). Once *stop is set no run starts and
+// the runs under way are dropped (within a second).
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
                                int offset, int stride, const std::atomic<bool>* stop,
                                bool progress);

@@ -28,7 +28,7 @@ int design(DesignArgs a) {
     throw CLI::ValidationError("--optimize", a.name + ": unknown (a scene key needs --range)");
   const Scene scene = load_scene(opt.scene_path);
   if (a.out_dir.empty()) a.out_dir = "out/design_" + scene.name;
-  opt.stop = stop_on_interrupt();
+  opt.stop = stop_on_interrupt("vines design", ", nothing will be written");
   DesignResult r;
   try {
     r = optimize_design(opt);

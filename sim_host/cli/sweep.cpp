@@ -25,7 +25,7 @@ int sweep(SweepArgs a) {
   const SweepSpec spec = load_sweep(a.spec_path);
   const std::vector<RunPlan> plan = plan_runs(spec);
   if (opt.out_dir.empty()) opt.out_dir = "out/" + std::filesystem::path(a.spec_path).stem().string();
-  const std::atomic<bool>* stop = stop_on_interrupt();
+  const std::atomic<bool>* stop = stop_on_interrupt("vines sweep", ": runs under way are dropped, the finished ones kept");
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<RunResult> results =
       execute(spec, plan, opt.threads, mpi.rank(), mpi.size(), stop, opt.progress && mpi.rank() == 0);
@@ -60,7 +60,8 @@ void add_sweep(CLI::App& vines) {
                               "Run the grid of scenes a study spec describes (data/studies/*.toml) on all cores (or "
                               "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv and "
                               "DIR/summary.json.",
-                              "Ctrl-C stops after the runs under way and keeps what finished (exit status 130).",
+                              "Ctrl-C drops the runs under way (within a second) and keeps what finished (exit status 130); a "
+                              "second Ctrl-C exits 130 at once.",
                               [a] { return sweep(*a); });
   cmd->add_option("SPEC.toml", a->spec_path,
                   "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
