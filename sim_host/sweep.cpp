@@ -20,6 +20,7 @@
 #include "sim_host/parallel.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene_toml.hpp"
+#include "sim_host/sweep_log.hpp"
 
 namespace vines::host {
 namespace {
@@ -331,17 +332,20 @@ json SweepSummary::to_json() const {
 }
 
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
-                               int offset, int stride, const std::atomic<bool>* stop, bool progress) {
+                               int offset, int stride, const std::atomic<bool>* stop, bool progress,
+                               SweepLog* log, std::vector<RunResult> finished) {
   std::vector<toml::table> bases;
   for (const StudySpec& st : spec.studies) bases.push_back(read_scene_table(st.scene_path));
-  // This rank's runs: every stride-th from offset, each stored at its index.
+  std::vector<RunResult> results = finished.empty() ? std::vector<RunResult>(plan.size()) : std::move(finished);
+  // This rank's runs not yet done: every stride-th from offset, each stored at its index.
   std::vector<std::size_t> mine;
   for (std::size_t i = static_cast<std::size_t>(offset); i < plan.size(); i += static_cast<std::size_t>(stride))
-    mine.push_back(i);
-  std::vector<RunResult> results(plan.size());
+    if (!results[i].done) mine.push_back(i);
   Cache cache(stop);
-  parallel_map(mine.size(), MapOptions{threads, stop, progress, "sweep", "runs"},
-               [&](std::size_t k) { results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache, stop); });
+  parallel_map(mine.size(), MapOptions{threads, stop, progress, "sweep", "runs"}, [&](std::size_t k) {
+    results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache, stop);
+    if (log != nullptr) log->append(mine[k], results[mine[k]]);
+  });
   return results;
 }
 
