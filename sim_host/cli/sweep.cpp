@@ -62,7 +62,7 @@ bool check_plan_size(const host::SweepSpec& spec, std::uint64_t n, const SweepAr
   const int threads = map_threads(a.opt.threads);
   std::vector<RunPlan> sample;
   for (int k = 0; k < 2 * threads; ++k) sample.push_back(plan_run(spec, n / (2 * threads) * k));
-  std::fprintf(stderr, "%s; timing %zu of its runs...\n", size, sample.size());
+  std::fprintf(stderr, "vines sweep: %s; timing %zu of its runs...\n", size, sample.size());
   const auto t0 = std::chrono::steady_clock::now();
   execute(spec, sample, a.opt.threads, 0, 1, stop, false);
   if (*stop) return false;
@@ -88,6 +88,7 @@ int sweep(SweepArgs a) {
   // The log of finished runs (one process only): read back with --resume, then appended to.
   std::unique_ptr<SweepLog> log;
   std::vector<RunResult> finished;
+  std::size_t resumed = 0;  // runs read back from the log
   const std::string log_file = (std::filesystem::path(opt.out_dir) / "runs.jsonl").string();
   if (!a.resume_dir.empty() && mpi.size() > 1) throw std::runtime_error("--resume: not under MPI (no log is kept)");
   if (mpi.size() == 1) {
@@ -99,6 +100,7 @@ int sweep(SweepArgs a) {
       std::fprintf(stderr, "vines sweep: resuming %s: %zu of %zu runs finished, %zu to run\n", log_file.c_str(),
                    c.finished, plan.size(), plan.size() - c.finished);
       keep = c.good_bytes;
+      resumed = c.finished;
       finished = std::move(c.results);
     }
     std::error_code ec;
@@ -114,9 +116,12 @@ int sweep(SweepArgs a) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
   const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
-  std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
-              a.spec_path.c_str(), s.done, plan.size(), wall, s.runs_per_s(), mpi.size(), mpi.size() > 1 ? "s" : "",
-              s.failed, opt.out_dir.c_str());
+  // The rate of the runs run now (a resumed sweep read the others from its log).
+  const std::size_t ran = s.done - resumed;
+  const std::string from_log = resumed > 0 ? " (" + std::to_string(resumed) + " from the log)" : "";
+  std::printf("sweep %s: %zu of %zu runs%s in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
+              a.spec_path.c_str(), s.done, plan.size(), from_log.c_str(), wall, wall > 0 ? ran / wall : 0.0,
+              mpi.size(), mpi.size() > 1 ? "s" : "", s.failed, opt.out_dir.c_str());
   // A line per study that has results: x_r and E_r, and the best value.
   for (const StudySummary& st : s.studies) {
     if (!st.x_r) continue;
@@ -142,14 +147,14 @@ void add_sweep(CLI::App& vines) {
   auto a = std::make_shared<SweepArgs>();
   CLI::App* cmd = add_command(vines, "sweep",
                               "Run the grid of scenes a study spec describes (data/studies/*.toml) on all cores (or "
-                              "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv and "
-                              "DIR/summary.json.",
+                              "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv, "
+                              "DIR/summary.json and DIR/runs.jsonl.",
                               "Every finished run is appended to DIR/runs.jsonl as it finishes (synced to disk every "
                               "0.2 s); results.csv and summary.json are written at the end, in plan order. Ctrl-C "
                               "drops the runs under way (within a second), writes the finished ones (\"complete\": "
                               "false) and exits 130; a second Ctrl-C exits 130 at once, the log intact. --resume DIR "
-                              "runs only the runs its log lacks. Plans of more than 1000000 runs print their size, "
-                              "memory and time and need --large.",
+                              "runs only the runs its log lacks (no log under MPI). Plans of more than 1000000 runs "
+                              "print their size, memory and time and need --large.",
                               [a] { return sweep(*a); });
   cmd->add_option("SPEC.toml", a->spec_path,
                   "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
@@ -163,7 +168,7 @@ void add_sweep(CLI::App& vines) {
       ->type_name("DIR")
       ->excludes("--out");
   cmd->add_flag("--large", a->large, "run a plan of more than 1000000 runs");
-  cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr");
+  cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr (nor the size and time of a sweep over a minute)");
 }
 
 }  // namespace vines::cli
