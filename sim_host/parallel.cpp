@@ -26,12 +26,28 @@ class Progress {
 
   void finished_one() {
     const std::size_t done = ++done_;
+    if (opt_.progress && !announced_.load() && elapsed() >= kAnnounceAfter_s) announce(done);
     if (opt_.progress && (done % every_ == 0 || done == total_)) report(done);
   }
 
  private:
+  static constexpr double kAnnounceAfter_s = 2.0;
+
+  double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+
+  // Once, a few seconds in: the size of a map that will take over a minute,
+  // and the time it will take at the rate so far.
+  void announce(std::size_t done) {
+    if (announced_.exchange(true)) return;
+    const double el = elapsed(), eta = el / static_cast<double>(done) * static_cast<double>(total_ - done);
+    if (eta < 60) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::fprintf(stderr, "%s%s: %zu %s in all, about %.0f min more at the rate of the first %.0f s "
+                 "(Ctrl-C stops)\n", tty_ ? "\n" : "", opt_.label.c_str(), total_, opt_.unit.c_str(), eta / 60, el);
+  }
+
   void report(std::size_t done) {
-    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    const double el = elapsed();
     const double eta = el / static_cast<double>(done) * static_cast<double>(total_ - done);
     std::lock_guard<std::mutex> lock(mutex_);
     if (tty_) {
@@ -51,6 +67,7 @@ class Progress {
   const std::size_t every_;
   const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
   std::atomic<std::size_t> done_{0};
+  std::atomic<bool> announced_{false};
   std::mutex mutex_;
 };
 
@@ -76,7 +93,12 @@ void parallel_map(std::size_t n, const MapOptions& opt, const std::function<void
               context.cancel_group_execution();
               return;
             }
-            job(i);
+            try {
+              job(i);
+            } catch (const Stopped&) {
+              context.cancel_group_execution();
+              return;
+            }
             progress.finished_one();
           }
         },

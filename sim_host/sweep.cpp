@@ -20,6 +20,7 @@
 #include "sim_host/parallel.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene_toml.hpp"
+#include "sim_host/sweep_log.hpp"
 
 namespace vines::host {
 namespace {
@@ -77,6 +78,8 @@ std::string key_of(const std::string& prefix, const toml::table& doc, std::initi
 // NES free travel; each keyed on every scene input it depends on.
 class Cache {
  public:
+  explicit Cache(const std::atomic<bool>* stop) : stop_(stop) {}
+
   std::shared_ptr<const Excitation> excitation(const RunScene& r) {
     return get<Excitation>(excitations_, record_key(r), [&] { return load_excitation(r.scene, ""); });
   }
@@ -84,7 +87,7 @@ class Cache {
     SceneParams p = r.scene.params;
     p.device.kind = DeviceKind::kNone;
     return get<RunTotals>(bares_, key_of(record_key(r), r.table, {"frame"}),
-                          [&] { return run_totals(r.scene, p, *excitation(r)); });
+                          [&] { return run_totals(r.scene, p, *excitation(r), stop_); });
   }
   // The tau a Kuwabara scene calibrates to (same for every initial condition).
   double tau(const RunScene& r) {
@@ -109,11 +112,17 @@ class Cache {
     return build_engine(p, s.scalar, s.path);
   }
   // A study run: its figures need the top floor and E_e, not every floor.
-  static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex) {
+  // The samples go in blocks (the same result, bit for bit, as one call),
+  // with a stop check between blocks.
+  static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex, const std::atomic<bool>* stop) {
+    constexpr std::size_t kBlock = 512;
     p.loop.floor_peaks = false;
     std::unique_ptr<Engine> e = build(s, p);
     e->init(ex.samples[0]);
-    e->run(ex.samples.data() + 1, ex.samples.size() - 1);
+    for (std::size_t k = 1; k < ex.samples.size(); k += kBlock) {
+      stop_point(stop);
+      e->run(ex.samples.data() + k, std::min(kBlock, ex.samples.size() - k));
+    }
     return e->totals();
   }
 
@@ -155,14 +164,16 @@ class Cache {
     return key_of(r.scene.path + '|' + rate, r.table, {"record"});
   }
 
+  const std::atomic<bool>* stop_;
   std::mutex mutex_;
   Map<Excitation> excitations_;
   Map<RunTotals> bares_;
   Map<double> taus_, gaps_;
 };
 
+// A run, or Stopped once *stop is set.
 RunResult run_one(const SweepSpec& spec, const RunPlan& plan, const std::vector<toml::table>& bases,
-                  Cache& cache) {
+                  Cache& cache, const std::atomic<bool>* stop) {
   const StudySpec& st = spec.studies[plan.study];
   RunResult r;
   try {
@@ -184,7 +195,7 @@ RunResult run_one(const SweepSpec& spec, const RunPlan& plan, const std::vector<
     if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
         p.device.vines.tau_s == 0.0)
       p.device.vines.tau_s = cache.tau(run);
-    const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run));
+    const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop);
     const RunTotals& b = *cache.bare(run);
     r.peak_top = t.peak_top;
     r.elastic_energy = t.elastic_energy;
@@ -321,17 +332,20 @@ json SweepSummary::to_json() const {
 }
 
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
-                               int offset, int stride, const std::atomic<bool>* stop, bool progress) {
+                               int offset, int stride, const std::atomic<bool>* stop, bool progress,
+                               SweepLog* log, std::vector<RunResult> finished) {
   std::vector<toml::table> bases;
   for (const StudySpec& st : spec.studies) bases.push_back(read_scene_table(st.scene_path));
-  // This rank's runs: every stride-th from offset, each stored at its index.
+  std::vector<RunResult> results = finished.empty() ? std::vector<RunResult>(plan.size()) : std::move(finished);
+  // This rank's runs not yet done: every stride-th from offset, each stored at its index.
   std::vector<std::size_t> mine;
   for (std::size_t i = static_cast<std::size_t>(offset); i < plan.size(); i += static_cast<std::size_t>(stride))
-    mine.push_back(i);
-  std::vector<RunResult> results(plan.size());
-  Cache cache;
-  parallel_map(mine.size(), MapOptions{threads, stop, progress, "sweep", "runs"},
-               [&](std::size_t k) { results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache); });
+    if (!results[i].done) mine.push_back(i);
+  Cache cache(stop);
+  parallel_map(mine.size(), MapOptions{threads, stop, progress, "sweep", "runs"}, [&](std::size_t k) {
+    results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache, stop);
+    if (log != nullptr) log->append(mine[k], results[mine[k]]);
+  });
   return results;
 }
 

@@ -20,6 +20,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +59,10 @@ struct RunResult {
   double x_r = 0, E_r = 0, peak_top = 0, elastic_energy = 0, residual = 0;
   long long contacts = 0, cap_hits = 0;
 };
+// A result as JSON (a line of DIR/runs.jsonl, sweep_log.hpp): every member,
+// by name; a member missing from the JSON keeps its default.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunResult, done, error, device, x_r, E_r, peak_top, elastic_energy,
+                                                residual, contacts, cap_hits)
 
 struct StudySpec {
   std::string name, scene_path, group_by, optimize;
@@ -71,16 +76,32 @@ struct SweepSpec {
   std::vector<StudySpec> studies;
 };
 
+// A spec whose grids make more runs than this is refused by load_sweep (from
+// the counts, before any value is built): its plan cannot fit in memory.
+inline constexpr std::uint64_t kMaxPlanRuns = 1000000000;
+
 SweepSpec load_sweep(const std::string& path);
+
+// The number of runs of the spec, from its axes (nothing materialised);
+// UINT64_MAX when the product overflows.
+std::uint64_t plan_size(const SweepSpec& spec);
+
+// Run `index` (< plan_size) of the spec.
+RunPlan plan_run(const SweepSpec& spec, std::uint64_t index);
 
 // Every run of the spec, in a fixed order (results are indexed by it).
 std::vector<RunPlan> plan_runs(const SweepSpec& spec);
 
-// Runs plan[i] for every i with i % stride == offset (others stay not done),
-// on `threads` threads (parallel_map); stops taking new runs once *stop is set.
+class SweepLog;
+
+// Runs plan[i] for every i with i % stride == offset (others stay not done)
+// that is not done in `finished` (empty, or one result per run: those of a
+// resumed sweep), on `threads` threads (parallel_map). Each finished run is
+// appended to *log when given. Once *stop is set no run starts and the runs
+// under way are dropped (within a second).
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
                                int offset, int stride, const std::atomic<bool>* stop,
-                               bool progress);
+                               bool progress, SweepLog* log = nullptr, std::vector<RunResult> finished = {});
 
 // Mean, sample standard deviation, range and count of some x_r or E_r.
 struct Stats {

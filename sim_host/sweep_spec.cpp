@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 
 #include "sim_host/scene.hpp"
@@ -78,6 +80,24 @@ std::vector<double> range_values(const std::string& where, const std::string& ke
     fail(where, key + ": a range needs 'step' or 'count'");
   }
   return out;
+}
+
+// The most values a grid key's list or range makes (before any is built; a
+// union may make fewer), saturating; a malformed range counts 1 (refused later).
+std::uint64_t axis_count(const toml::node& n) {
+  auto range = [](const toml::table& t) -> std::uint64_t {
+    const auto from = t["from"].value<double>(), to = t["to"].value<double>(), step = t["step"].value<double>();
+    const auto count = t["count"].value<int64_t>();
+    if (count && *count > 0) return static_cast<std::uint64_t>(*count);
+    if (!from || !to || !step || !(*step > 0)) return 1;
+    const double k = std::floor((*to - *from) / *step + 1e-9) + 1;
+    return k < 1 ? 1 : k > 1e18 ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(k);
+  };
+  if (const toml::table* t = n.as_table()) return range(*t);
+  std::uint64_t k = 0;
+  if (const toml::array* a = n.as_array())
+    for (auto&& e : *a) k = std::min<std::uint64_t>(k + (e.as_table() ? range(*e.as_table()) : 1), 1ULL << 62);
+  return k;
 }
 
 Scaled grid_axis(const std::string& where, const std::string& key, const toml::node& n) {
@@ -160,6 +180,7 @@ SweepSpec load_sweep(const std::string& path) {
   if (!studies || studies->empty()) fail(path, "needs at least one [[study]]");
   SweepSpec spec;
   spec.path = path;
+  double planned = 0;  // runs of the studies so far
   for (auto&& node : *studies) {
     const toml::table* t = node.as_table();
     if (!t) fail(path, "study: must be a table");
@@ -180,6 +201,19 @@ SweepSpec load_sweep(const std::string& path) {
         if (!e.as_table()) fail(where, "cases: each case is a table of key = value");
         st.cases.push_back(key_values(where, *e.as_table()));
       }
+    // The size of the plan so far, from the counts alone: a grid beyond any
+    // machine (a 1e5 x 1e5 grid) is refused before a value is built.
+    if (auto g = t->at_path("grid").as_table()) {
+      double runs = static_cast<double>(std::max<std::size_t>(1, st.cases.size()));
+      for (auto&& kv : *g) runs *= static_cast<double>(axis_count(kv.second));
+      planned += runs;
+      if (planned > static_cast<double>(kMaxPlanRuns)) {
+        char size[96];
+        std::snprintf(size, sizeof size, "the plan has %.0f runs, more than any sweep can hold (%llu)", planned,
+                      static_cast<unsigned long long>(kMaxPlanRuns));
+        fail(where, std::string(size) + ": split the grid");
+      }
+    }
     if (auto g = t->at_path("grid").as_table())
       for (auto&& kv : *g) {
         Scaled ax = grid_axis(where, std::string(kv.first.str()), kv.second);
@@ -207,24 +241,60 @@ SweepSpec load_sweep(const std::string& path) {
   return spec;
 }
 
-std::vector<RunPlan> plan_runs(const SweepSpec& spec) {
-  std::vector<RunPlan> out;
-  for (int s = 0; s < static_cast<int>(spec.studies.size()); ++s) {
-    const StudySpec& st = spec.studies[s];
-    const std::vector<std::vector<KeyValue>> cases = st.cases.empty() ? std::vector<std::vector<KeyValue>>{{}} : st.cases;
-    for (const auto& c : cases) {
-      // Odometer over the grid axes, last axis fastest.
-      std::vector<std::size_t> idx(st.grid_axes.size(), 0);
-      while (true) {
-        RunPlan r{s, c};
-        for (std::size_t a = 0; a < idx.size(); ++a) r.values.push_back(st.grid_axes[a][idx[a]]);
-        out.push_back(r);
-        std::size_t a = idx.size();
-        while (a > 0 && ++idx[a - 1] == st.grid_axes[a - 1].size()) idx[--a] = 0;
-        if (a == 0) break;
-      }
-    }
+namespace {
+
+// a * b, or UINT64_MAX when it overflows (or either is).
+std::uint64_t times(std::uint64_t a, std::uint64_t b) {
+  constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+  return a != 0 && b > kMax / a ? kMax : a * b;
+}
+
+// The runs of one study: its cases times the product of its axis lengths.
+std::uint64_t grid_size(const StudySpec& st) {
+  std::uint64_t n = 1;
+  for (const auto& ax : st.grid_axes) n = times(n, ax.size());
+  return n;
+}
+
+std::uint64_t study_size(const StudySpec& st) {
+  return times(std::max<std::uint64_t>(1, st.cases.size()), grid_size(st));
+}
+
+}  // namespace
+
+std::uint64_t plan_size(const SweepSpec& spec) {
+  constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+  std::uint64_t n = 0;
+  for (const StudySpec& st : spec.studies) {
+    const std::uint64_t m = study_size(st);
+    n = m > kMax - n ? kMax : n + m;
   }
+  return n;
+}
+
+// Studies in order; in a study, cases outer, then the grid axes as an
+// odometer, last axis fastest.
+RunPlan plan_run(const SweepSpec& spec, std::uint64_t index) {
+  int s = 0;
+  while (index >= study_size(spec.studies[s])) index -= study_size(spec.studies[s++]);
+  const StudySpec& st = spec.studies[s];
+  const std::uint64_t per_case = grid_size(st);
+  RunPlan r{s, st.cases.empty() ? std::vector<KeyValue>{} : st.cases[index / per_case]};
+  std::uint64_t rest = index % per_case;
+  std::vector<KeyValue> grid(st.grid_axes.size());
+  for (std::size_t a = st.grid_axes.size(); a-- > 0;) {
+    grid[a] = st.grid_axes[a][rest % st.grid_axes[a].size()];
+    rest /= st.grid_axes[a].size();
+  }
+  r.values.insert(r.values.end(), grid.begin(), grid.end());
+  return r;
+}
+
+std::vector<RunPlan> plan_runs(const SweepSpec& spec) {
+  const std::uint64_t n = plan_size(spec);
+  std::vector<RunPlan> out;
+  out.reserve(n);
+  for (std::uint64_t i = 0; i < n; ++i) out.push_back(plan_run(spec, i));
   return out;
 }
 

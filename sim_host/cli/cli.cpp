@@ -2,9 +2,13 @@
 #include "sim_host/cli/cli.hpp"
 
 #include <cmath>
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <algorithm>
 #include <limits>
 #include <utility>
 
@@ -66,7 +70,18 @@ std::string number_text(double x) {
   return s;
 }
 
+// Ctrl-C: the flag, and the line the handler writes (set before the
+// handler is installed; write(2) and _exit are async-signal-safe).
 std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the handler needs a lock-free flag");
+char g_ack[512];
+std::size_t g_ack_len = 0;
+
+void on_interrupt(int) {
+  if (g_stop.exchange(true)) _exit(kInterrupted);
+  const ssize_t n = write(STDERR_FILENO, g_ack, g_ack_len);
+  (void)n;  // nothing to do if stderr is gone
+}
 
 }  // namespace
 
@@ -110,11 +125,15 @@ CLI::Validator non_empty_path() {
                         "");
 }
 
-const std::atomic<bool>* stop_on_interrupt() {
-  std::signal(SIGINT, [](int) {
-    g_stop = true;
-    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends at once
-  });
+const std::atomic<bool>* stop_on_interrupt(const std::string& command, const std::string& what) {
+  const std::string line = "\n" + command + ": stopping (Ctrl-C)" + what + "; Ctrl-C again to quit now\n";
+  g_ack_len = std::min(line.size(), sizeof g_ack);
+  std::memcpy(g_ack, line.data(), g_ack_len);
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGINT, &sa, nullptr);
   return &g_stop;
 }
 

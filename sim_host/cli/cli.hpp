@@ -41,10 +41,11 @@ CLI::Validator positive_up_to(double hi);
 // Check of a file or folder option (--out, --csv): not an empty path.
 CLI::Validator non_empty_path();
 
-// Ctrl-C from now on sets the returned flag (a run under way stops at its next
-// check and keeps what finished, status kInterrupted); a second Ctrl-C ends
-// the program at once.
-const std::atomic<bool>* stop_on_interrupt();
+// Ctrl-C from now on sets the returned flag (runs under way stop at their
+// next check, within a second; the command keeps what finished, status
+// kInterrupted) and prints at once "COMMAND: stopping (Ctrl-C)WHAT; Ctrl-C
+// again to quit now"; a second Ctrl-C exits kInterrupted at once.
+const std::atomic<bool>* stop_on_interrupt(const std::string& command, const std::string& what);
 
 // Help in the layout of every `vines` command: the usage line made of the
 // command's arguments, its summary, one line per option (groups under their

@@ -27,7 +27,7 @@ int design(DesignArgs a) {
   const Scene scene = load_scene(opt.scene_path);
   if (a.out_dir.empty()) a.out_dir = "out/design_" + safe_file_name(scene.name);
   const OutputDir out(a.out_dir, "vines design", {"design.json"});  // claimed before the search
-  opt.stop = stop_on_interrupt();
+  opt.stop = stop_on_interrupt("vines design", ", nothing will be written");
   DesignResult r;
   try {
     r = optimize_design(opt);

@@ -105,7 +105,7 @@ int stress(const StressArgs& a) {
     std::printf("%s\n", j.dump(a.as_json ? -1 : 2).c_str());
     return r.ok() ? kOk : kRefused;
   }
-  const std::atomic<bool>* stop = stop_on_interrupt();
+  const std::atomic<bool>* stop = stop_on_interrupt("vines stress", ": the cases under way are dropped, the finished ones reported");
   const StressRun run = run_stress(opt, records, stop);
   StressSummary s = stress_summary(opt, run, a.worst);
   // --out: the worst cases as scenes, every case run, and stress.json last.

@@ -1,47 +1,131 @@
 // `vines sweep SPEC.toml`: the grid of runs of a study spec, on threads and MPI ranks.
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/output.hpp"
+#include "sim_host/parallel.hpp"
 #include "sim_host/sweep.hpp"
+#include "sim_host/sweep_log.hpp"
 #include "sim_host/sweep_mpi.hpp"
 
 namespace vines::cli {
 namespace {
 
+// Plans above this many runs need --large.
+constexpr std::uint64_t kLargePlan = 1000000;
+
 struct SweepArgs {
-  std::string spec_path;
+  std::string spec_path, resume_dir;
+  bool large = false;
   host::SweepOptions opt;
   const CLI::Option* out = nullptr;  // --out, given or not
 };
+
+std::string duration_text(double s) {
+  char t[32];
+  if (s < 120) std::snprintf(t, sizeof t, "%.0f s", s);
+  else if (s < 7200) std::snprintf(t, sizeof t, "%.0f min", s / 60);
+  else std::snprintf(t, sizeof t, "%.1f h", s / 3600);
+  return t;
+}
+
+// A plan above kLargePlan runs: its size, the memory its plan and results
+// take, and (when that fits in memory) its time from a timed sample of runs;
+// refused without --large, and whatever the options when it cannot fit.
+// Returns false when Ctrl-C stopped the sample.
+bool check_plan_size(const host::SweepSpec& spec, std::uint64_t n, const SweepArgs& a,
+                     const std::atomic<bool>* stop) {
+  using namespace vines::host;
+  if (n <= kLargePlan) return true;
+  std::size_t values = 0;
+  for (const StudySpec& st : spec.studies)
+    values = std::max(values, (st.cases.empty() ? 0 : st.cases.front().size()) + st.grid_axes.size());
+  const double per_run = sizeof(RunPlan) + sizeof(RunResult) + values * (sizeof(KeyValue) + 32.0);
+  const double memory = static_cast<double>(n) * per_run;
+  const double ram = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  char size[160];
+  std::snprintf(size, sizeof size, "%s: the plan has %llu runs (more than %llu) and needs about %.1f GB of memory",
+                a.spec_path.c_str(), static_cast<unsigned long long>(n), static_cast<unsigned long long>(kLargePlan),
+                memory / 1e9);
+  if (memory > ram / 2)
+    throw std::runtime_error(std::string(size) + ", more than half of this machine's " +
+                             std::to_string(static_cast<long long>(ram / 1e9)) + " GB: split the grid");
+  // Time: a few runs spread over the plan, on the threads the sweep will use.
+  const int threads = map_threads(a.opt.threads);
+  std::vector<RunPlan> sample;
+  for (int k = 0; k < 2 * threads; ++k) sample.push_back(plan_run(spec, n / (2 * threads) * k));
+  std::fprintf(stderr, "vines sweep: %s; timing %zu of its runs...\n", size, sample.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  execute(spec, sample, a.opt.threads, 0, 1, stop, false);
+  if (*stop) return false;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string time = "about " + duration_text(wall / sample.size() * static_cast<double>(n)) + " on " +
+                           std::to_string(threads) + " threads";
+  if (!a.large) throw std::runtime_error(std::string(size) + ", " + time + ": pass --large to run it");
+  std::fprintf(stderr, "vines sweep: %llu runs, %s (--large)\n", static_cast<unsigned long long>(n), time.c_str());
+  return true;
+}
 
 int sweep(SweepArgs a) {
   using namespace vines::host;
   SweepOptions& opt = a.opt;
   Mpi mpi;
   const SweepSpec spec = load_sweep(a.spec_path);
+  const std::atomic<bool>* stop =
+      stop_on_interrupt("vines sweep", ": runs under way are dropped, the finished ones kept");
+  if (!check_plan_size(spec, plan_size(spec), a, stop)) return kInterrupted;
   const std::vector<RunPlan> plan = plan_runs(spec);
-  if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(std::filesystem::path(a.spec_path).stem().string());
+  if (!a.resume_dir.empty()) opt.out_dir = a.resume_dir;
+  else if (a.out->count() == 0)
+    opt.out_dir = "out/" + safe_file_name(std::filesystem::path(a.spec_path).stem().string());
   // The folder is claimed before the runs, by every rank (a refusal stops them
   // all alike, none is left waiting for rank 0); rank 0 writes it.
-  const OutputDir out(opt.out_dir, "vines sweep", {"results.csv", "summary.json"});
-  const std::atomic<bool>* stop = stop_on_interrupt();
+  const OutputDir out(opt.out_dir, "vines sweep", {"results.csv", "summary.json", "runs.jsonl"});
+  // The log of finished runs (one process only): read back with --resume, then appended to.
+  std::unique_ptr<SweepLog> log;
+  std::vector<RunResult> finished;
+  std::size_t resumed = 0;  // runs read back from the log
+  const std::string log_file = (std::filesystem::path(opt.out_dir) / "runs.jsonl").string();
+  if (!a.resume_dir.empty() && mpi.size() > 1) throw std::runtime_error("--resume: not under MPI (no log is kept)");
+  if (mpi.size() == 1) {
+    const std::string fingerprint = plan_fingerprint(spec, plan);
+    std::size_t keep = 0;
+    if (!a.resume_dir.empty()) {
+      SweepLogContents c = read_sweep_log(log_file, fingerprint, plan.size());
+      if (!c.warning.empty()) std::fprintf(stderr, "vines sweep: warning: %s\n", c.warning.c_str());
+      std::fprintf(stderr, "vines sweep: resuming %s: %zu of %zu runs finished, %zu to run\n", log_file.c_str(),
+                   c.finished, plan.size(), plan.size() - c.finished);
+      keep = c.good_bytes;
+      resumed = c.finished;
+      finished = std::move(c.results);
+    }
+    log = std::make_unique<SweepLog>(log_file, a.spec_path, fingerprint, plan.size(), keep);
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<RunResult> results =
-      execute(spec, plan, opt.threads, mpi.rank(), mpi.size(), stop, opt.progress && mpi.rank() == 0);
+  std::vector<RunResult> results = execute(spec, plan, opt.threads, mpi.rank(), mpi.size(), stop,
+                                           opt.progress && mpi.rank() == 0, log.get(), std::move(finished));
+  if (log) log->close();
   mpi.gather(&results);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
   const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
-  out.finish({"results.csv", "summary.json"});
-  std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
-              a.spec_path.c_str(), s.done, plan.size(), wall, s.runs_per_s(), mpi.size(), mpi.size() > 1 ? "s" : "",
-              s.failed, opt.out_dir.c_str());
+  out.finish({"results.csv", "summary.json", "runs.jsonl"});
+  // The rate of the runs run now (a resumed sweep read the others from its log).
+  const std::size_t ran = s.done - resumed;
+  const std::string from_log = resumed > 0 ? " (" + std::to_string(resumed) + " from the log)" : "";
+  std::printf("sweep %s: %zu of %zu runs%s in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
+              a.spec_path.c_str(), s.done, plan.size(), from_log.c_str(), wall, wall > 0 ? ran / wall : 0.0,
+              mpi.size(), mpi.size() > 1 ? "s" : "", s.failed, opt.out_dir.c_str());
   // A line per study that has results: x_r and E_r, and the best value.
   for (const StudySummary& st : s.studies) {
     if (!st.x_r) continue;
@@ -52,7 +136,10 @@ int sweep(SweepArgs a) {
     std::printf("\n");
   }
   if (*stop) {
-    std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s.done);
+    std::fprintf(stderr,
+                 "vines sweep: stopped (Ctrl-C): %s/results.csv and summary.json hold the %zu finished of %zu runs "
+                 "(\"complete\": false); vines sweep %s --resume %s runs the rest\n",
+                 opt.out_dir.c_str(), s.done, plan.size(), a.spec_path.c_str(), opt.out_dir.c_str());
     return kInterrupted;
   }
   return s.failed == 0 ? kOk : kRefused;
@@ -64,9 +151,14 @@ void add_sweep(CLI::App& vines) {
   auto a = std::make_shared<SweepArgs>();
   CLI::App* cmd = add_command(vines, "sweep",
                               "Run the grid of scenes a study spec describes (data/studies/*.toml) on all cores (or "
-                              "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv and "
-                              "DIR/summary.json.",
-                              "Ctrl-C stops after the runs under way and keeps what finished (exit status 130).",
+                              "MPI ranks: mpirun -n K vines sweep ...); writes DIR/results.csv, "
+                              "DIR/summary.json and DIR/runs.jsonl.",
+                              "Every finished run is appended to DIR/runs.jsonl as it finishes (synced to disk every "
+                              "0.2 s); results.csv and summary.json are written at the end, in plan order. Ctrl-C "
+                              "drops the runs under way (within a second), writes the finished ones (\"complete\": "
+                              "false) and exits 130; a second Ctrl-C exits 130 at once, the log intact. --resume DIR "
+                              "runs only the runs its log lacks (no log under MPI). Plans of more than 1000000 runs "
+                              "print their size, memory and time and need --large.",
                               [a] { return sweep(*a); });
   cmd->add_option("SPEC.toml", a->spec_path,
                   "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
@@ -78,7 +170,12 @@ void add_sweep(CLI::App& vines) {
   cmd->add_option("--threads", a->opt.threads, "worker threads (default: all cores; per rank under MPI)")
       ->type_name("N")
       ->check(number_in(1, 1024));
-  cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr");
+  cmd->add_option("--resume", a->resume_dir,
+                  "finish the sweep of this spec in DIR (its DIR/runs.jsonl): run only the runs not finished")
+      ->type_name("DIR")
+      ->excludes("--out");
+  cmd->add_flag("--large", a->large, "run a plan of more than 1000000 runs");
+  cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr (nor the size and time of a sweep over a minute)");
 }
 
 }  // namespace vines::cli
