@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -72,11 +73,13 @@ RunResult result_from(json j) {
 std::string plan_fingerprint(const SweepSpec& spec, const std::vector<RunPlan>& plan) {
   Digest d;
   d.add("vines sweep plan " + std::to_string(kLogVersion));
-  // Each study's settings and its scene as parsed (toml++ prints it in a fixed order).
+  // Each study's settings, its scene file (wherever the sweep is started from) and the
+  // scene as parsed (toml++ prints it in a fixed order).
   for (const StudySpec& st : spec.studies) {
     std::ostringstream scene;
     scene << read_scene_table(st.scene_path);
-    for (const std::string& s : {st.name, st.scene_path, st.group_by, st.optimize, scene.str()}) d.add(s);
+    const std::string where = std::filesystem::weakly_canonical(st.scene_path).string();
+    for (const std::string& s : {st.name, where, st.group_by, st.optimize, scene.str()}) d.add(s);
     for (const KeyValue& v : st.set) d.add(v.key + "=" + v.label());
   }
   // Every run: its study and keys, in plan order.
