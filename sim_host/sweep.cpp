@@ -83,8 +83,12 @@ class Cache {
   std::shared_ptr<const RunTotals> bare(const RunScene& r) {
     SceneParams p = r.scene.params;
     p.device.kind = DeviceKind::kNone;
-    return get<RunTotals>(bares_, key_of(record_key(r), r.table, {"frame"}),
-                          [&] { return run_totals(r.scene, p, *excitation(r)); });
+    // Keyed on the frame and the loop (scalar, divergence limit, ledger) less
+    // the keys only contacts read.
+    const std::string key = key_of(record_key(r), r.table, {"frame", "loop"},
+                                   {"loop.contact_rtol", "loop.max_substeps_per_step", "loop.contact_count_depth_m",
+                                    "loop.contact_scheme", "loop.bounded_substeps", "loop.floor_peaks"});
+    return get<RunTotals>(bares_, key, [&] { return run_totals(r.scene, p, *excitation(r)); });
   }
   // The tau a Kuwabara scene calibrates to (same for every initial condition).
   double tau(const RunScene& r) {
