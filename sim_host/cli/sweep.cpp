@@ -16,6 +16,7 @@ namespace {
 struct SweepArgs {
   std::string spec_path;
   host::SweepOptions opt;
+  bool accept_degraded = false;
 };
 
 int sweep(SweepArgs a) {
@@ -33,23 +34,31 @@ int sweep(SweepArgs a) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
   const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
-  std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
+  std::printf("sweep %s: %zu of %zu runs in %.2f s (%.1f runs/s, %d rank%s), %zu failed, %zu degraded; results in "
+              "%s/\n",
               a.spec_path.c_str(), s.done, plan.size(), wall, s.runs_per_s(), mpi.size(), mpi.size() > 1 ? "s" : "",
-              s.failed, opt.out_dir.c_str());
-  // A line per study that has results: x_r and E_r, and the best value.
+              s.failed, s.degraded, opt.out_dir.c_str());
+  // A line per study that has results: x_r and E_r over its ok runs, the best value, the degraded runs.
   for (const StudySummary& st : s.studies) {
-    if (!st.x_r) continue;
-    std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", st.name.c_str(),
-                st.device.c_str(), st.runs, 100 * st.x_r->mean, 100 * st.x_r->sd, 100 * st.x_r->min,
-                100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
+    if (st.runs == 0) continue;
+    std::printf("  %-24s %-5s n=%-5zu", st.name.c_str(), st.device.c_str(), st.runs - st.degraded);
+    if (st.x_r)
+      std::printf(" x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", 100 * st.x_r->mean,
+                  100 * st.x_r->sd, 100 * st.x_r->min, 100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
     if (!st.optimize.empty() && !st.groups.empty()) std::printf("  best %s = %g", st.group_by.c_str(), st.best_value);
+    if (st.degraded > 0) std::printf("  (%zu degraded, not counted)", st.degraded);
+    if (!st.energy_checked) std::printf("  (energy balance not computed)");
     std::printf("\n");
   }
   if (*stop) {
     std::fprintf(stderr, "vines sweep: interrupted; kept the %zu finished runs\n", s.done);
     return kInterrupted;
   }
-  return s.failed == 0 ? kOk : kRefused;
+  if (s.failed > 0) return kRefused;
+  if (s.degraded > 0)
+    std::fprintf(stderr, "vines sweep: %zu runs DEGRADED (their status and reasons in %s/results.csv)\n", s.degraded,
+                 opt.out_dir.c_str());
+  return finished_status(s.degraded > 0, a.accept_degraded);
 }
 
 }  // namespace
@@ -70,6 +79,7 @@ void add_sweep(CLI::App& vines) {
       ->type_name("N")
       ->check(number_in(1, 1024));
   cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr");
+  add_accept_degraded(*cmd, &a->accept_degraded);
 }
 
 }  // namespace vines::cli
