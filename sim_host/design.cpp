@@ -40,10 +40,11 @@ std::vector<DesignEvaluation> evaluate(const DesignOptions& opt, const std::vect
   std::vector<int> count(values.size(), 0);
   for (std::size_t i = 0; i < plan.size(); ++i) {
     if (!res[i].error.empty()) throw std::runtime_error(res[i].error);
-    DesignEvaluation& e = out[i % values.size()];  // cases outer, grid inner
+    const std::size_t j = i % values.size();  // cases outer, grid inner
+    DesignEvaluation& e = out[j];
     const double m = opt.metric == "E_r" ? res[i].E_r : res[i].x_r;
-    e.objective = opt.objective == "worst" ? (count[i % values.size()] ? std::min(e.objective, m) : m) : e.objective + m;
-    ++count[i % values.size()];
+    e.objective = opt.objective == "worst" ? (count[j] ? std::min(e.objective, m) : m) : e.objective + m;
+    ++count[j];
     if (res[i].degraded) e.degraded_reasons += (e.degraded_reasons.empty() ? "" : ";") + res[i].degraded_reasons;
   }
   if (opt.objective != "worst")
@@ -118,8 +119,11 @@ std::size_t DesignResult::degraded() const {
 json DesignResult::to_json() const {
   json evals = json::array();
   for (const DesignEvaluation& e : evaluations)
-    evals.push_back({{"value", e.value}, {"objective", e.objective}, {"phase", e.phase},
-                     {"status", e.degraded_reasons.empty() ? "ok" : "degraded"}, {"degraded_reasons", e.degraded_reasons}});
+    evals.push_back({{"value", e.value},
+                     {"objective", e.objective},
+                     {"phase", e.phase},
+                     {"status", e.degraded_reasons.empty() ? "ok" : "degraded"},
+                     {"degraded_reasons", e.degraded_reasons}});
   const DesignOptions& o = options;
   const json best = found ? json{{"value", best_value}, {"objective", best_objective}} : json(nullptr);
   return {{"scene", o.scene_path}, {"key", o.key}, {"metric", o.metric}, {"objective", o.objective},

@@ -63,9 +63,9 @@ void add_design(CLI::App& vines) {
   CLI::App* cmd = add_command(vines, "design",
                               "Best value of one design parameter for the scene's record or a set of records (mean "
                               "or worst case): coarse grid, then golden-section refinement.",
-                              "A value with a degraded run cannot be the best; when every value is degraded there is no best (exit "
-                              "status 3). Ctrl-C stops the search after the runs under way; nothing is written (exit "
-                              "status 130).",
+                              "A value with a degraded run cannot be the best; when every value is degraded there is "
+                              "no best (exit status 3). Ctrl-C stops the search after the runs under way; nothing is "
+                              "written (exit status 130).",
                               [a] { return design(*a); });
   cmd->add_option("SCENE.toml", opt.scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--optimize", a->name,
