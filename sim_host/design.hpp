@@ -29,17 +29,22 @@ struct DesignOptions {
 // scene key. Fills key and the default range; false if unknown.
 bool design_parameter(const std::string& name, DesignOptions* opt);
 
-// One value tried: its objective, and in which phase ("grid", "refine").
+// One value tried: its objective, and in which phase ("grid", "refine"). A
+// value with a degraded run (on any record) cannot be the best: the search
+// takes it as worse than every other.
 struct DesignEvaluation {
   double value = 0, objective = 0;
   std::string phase;
+  std::string degraded_reasons;  // codes of its degraded runs ("": ok)
 };
 
 // design.json: the search, the best value found and every evaluation.
 struct DesignResult {
   DesignOptions options;
   double best_value = 0, best_objective = 0;
+  bool found = false;  // false: every value tried was degraded (best_* mean nothing)
   std::vector<DesignEvaluation> evaluations;
+  std::size_t degraded() const;
   nlohmann::json to_json() const;
 };
 

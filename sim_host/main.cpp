@@ -1,6 +1,7 @@
 // vines: command-line front end of the VI NES firmware model. The commands are
 // in sim_host/cli/, one file each; this builds the app from them and turns what
-// happened into the exit status (cli.hpp: 0, 1 refused input, 2 usage, 130).
+// happened into the exit status (cli.hpp: 0, 1 refused input, 2 usage, 3
+// degraded results, 130).
 #include <cstdio>
 #include <exception>
 
@@ -10,7 +11,8 @@ int main(int argc, char** argv) {
   using namespace vines::cli;
   CLI::App vines("vines - Vibro-Impact Nonlinear Energy Sink firmware model (host build)", "vines");
   vines.footer("Records are looked up as given, next to the scene file, then in $VINES_GROUND_MOTIONS (default: "
-               "../shared/data/ground_motions beside the repository).");
+               "../shared/data/ground_motions beside the repository).\nExit status: 0 done, 1 refused input or a "
+               "failed run, 2 usage error, 3 finished but a result is degraded (--accept-degraded: 0), 130 Ctrl-C.");
   vines.require_subcommand(1);
   // An option given twice: the last one counts.
   vines.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);

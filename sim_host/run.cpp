@@ -179,6 +179,7 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
   r.totals = dev.totals;
   if (has_device) r.bare = bare.totals;
   r.wall_s = dev.wall_s;
+  r.status = device_status(r.totals, r.bare ? &*r.bare : nullptr, p, r.info, r.scalar);
 
   // The run's folder: timeseries.csv, then summary.json (the file that says the
   // run is complete) last; a timeseries.csv of an earlier run is removed.
@@ -229,6 +230,7 @@ json RunReport::to_json() const {
                      {"residual", l.residual}};
   } else {
     j["energy_balance_residual"] = nullptr;
+    j["energy_balance"] = "not computed (loop.energy_ledger = false)";
   }
   j["counters"] = {{"steps", t.count.steps},
                    {"substep_steps", t.count.careful_steps},
@@ -244,6 +246,9 @@ json RunReport::to_json() const {
   j["modal"] = modal_json(info);
   if (bare) j["device_params"] = device_json(p.device.kind, info);
   j["wall_time_s"] = wall_s;
+  // Whether the figures above can be trusted (docs/model.md, "Run status").
+  j["status"] = status.name();
+  j["degraded_reasons"] = status.reasons_json();
   return j;
 }
 

@@ -11,6 +11,7 @@
 
 #include "sim_host/engine.hpp"
 #include "sim_host/scene.hpp"
+#include "sim_host/status.hpp"
 
 namespace vines::host {
 
@@ -52,6 +53,7 @@ struct RunReport {
   RunTotals totals;               // the device run
   std::optional<RunTotals> bare;  // with a device: the bare frame on the same record
   double wall_s = 0;              // the device run's loop
+  RunStatus status;               // ok, or degraded and why (either run)
   double x_r() const { return reduction(bare->peak_top, totals.peak_top); }
   double E_r() const { return reduction(bare->elastic_energy, totals.elastic_energy); }
   nlohmann::json to_json() const;

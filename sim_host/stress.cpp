@@ -10,6 +10,7 @@
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/parallel.hpp"
+#include "sim_host/status.hpp"
 
 namespace vines::host {
 namespace {
@@ -240,6 +241,7 @@ StressResult run_case(const StressCase& c, const std::vector<StressRecord>& reco
   r.checks[kGuards] = {true, static_cast<double>(t.count.divergences + t.count.bad_samples), 0.0};
   r.checks[kCap] = {vines, static_cast<double>(t.count.cap_hits), 0.0};
   if (vines) check_overlap(c, info, full, &r);
+  r.degraded_reasons = run_status(t, c.params, info, c.scalar).codes();
   // The other runs reuse the calibrated Kuwabara tau.
   SceneParams p = c.params;
   if (vines && p.device.vines.law == ContactLaw::kKuwabara && info.vines.tau > 0) p.device.vines.tau_s = info.vines.tau;
@@ -275,6 +277,7 @@ json case_report(const StressCase& c, const StressResult& r, const std::vector<S
   json j = {{"scene", case_json(c, records)}, {"ok", r.ok()}, {"steps", r.steps}, {"contacts", r.contacts},
             {"cap_hits", r.cap_hits}, {"wall_time_s", r.wall_s}, {"checks", checks}, {"detail", r.detail}};
   if (!r.refusal.empty()) j["refused"] = r.refusal;
+  else j.update({{"status", r.degraded_reasons.empty() ? "ok" : "degraded"}, {"degraded_reasons", r.degraded_reasons}});
   return j;
 }
 
@@ -292,6 +295,7 @@ StressSummary stress_summary(const StressOptions& opt, const StressRun& run, int
     ++s.cases;
     s.steps += r.steps;
     s.failed += !r.ok();
+    s.degraded += !r.degraded_reasons.empty();
     if (r.refusal.empty()) continue;
     ++s.refused;
     ++refusals.try_emplace(r.refusal, RefusalSummary{r.refusal, 0, static_cast<std::int64_t>(i)}).first->second.cases;
@@ -338,7 +342,8 @@ json StressSummary::to_json(const StressRun& run, const std::vector<StressRecord
     ref.push_back({{"reason", r.reason}, {"cases", r.cases}, {"first_case", r.first_case}});
   return {{"seed", seed},       {"cases", cases},        {"requested", requested}, {"refused", refused},
           {"failed", failed},   {"passed", passed},      {"steps", steps},         {"max_steps_per_run", max_steps_per_run},
-          {"wall_time_s", wall_s}, {"cases_per_s", cases_per_s()}, {"refusals", ref}, {"checks", jc}};
+          {"wall_time_s", wall_s}, {"cases_per_s", cases_per_s()}, {"refusals", ref}, {"checks", jc},
+          {"degraded", degraded}};
 }
 
 }  // namespace vines::host

@@ -95,6 +95,7 @@ struct StressResult {
   std::array<CheckResult, kCheckCount> checks{};
   std::int64_t steps = 0, contacts = 0, cap_hits = 0;
   double wall_s = 0;
+  std::string degraded_reasons;  // its run's status (sim_host/status.hpp): codes, "" when ok
   nlohmann::json detail;  // the numbers behind the checks
   bool ok() const;
 };
@@ -144,6 +145,7 @@ struct StressSummary {
   std::uint64_t seed = 0;
   std::int64_t requested = 0;
   std::size_t cases = 0, refused = 0, failed = 0;  // cases: run (all unless interrupted)
+  std::size_t degraded = 0;  // cases whose run status is degraded (as `vines run` would report it)
   bool passed = false;
   std::int64_t steps = 0;
   int max_steps_per_run = 0;

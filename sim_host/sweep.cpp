@@ -21,6 +21,7 @@
 #include "sim_host/run.hpp"
 #include "sim_host/scene_toml.hpp"
 #include "sim_host/sweep_log.hpp"
+#include "sim_host/status.hpp"
 
 namespace vines::host {
 namespace {
@@ -86,8 +87,12 @@ class Cache {
   std::shared_ptr<const RunTotals> bare(const RunScene& r) {
     SceneParams p = r.scene.params;
     p.device.kind = DeviceKind::kNone;
-    return get<RunTotals>(bares_, key_of(record_key(r), r.table, {"frame"}),
-                          [&] { return run_totals(r.scene, p, *excitation(r), stop_); });
+    // Keyed on the frame and the loop (scalar, divergence limit, ledger) less
+    // the keys only contacts read.
+    const std::string key = key_of(record_key(r), r.table, {"frame", "loop"},
+                                   {"loop.contact_rtol", "loop.max_substeps_per_step", "loop.contact_count_depth_m",
+                                    "loop.contact_scheme", "loop.bounded_substeps", "loop.floor_peaks"});
+    return get<RunTotals>(bares_, key, [&] { return run_totals(r.scene, p, *excitation(r), stop_); });
   }
   // The tau a Kuwabara scene calibrates to (same for every initial condition).
   double tau(const RunScene& r) {
@@ -113,11 +118,13 @@ class Cache {
   }
   // A study run: its figures need the top floor and E_e, not every floor.
   // The samples go in blocks (the same result, bit for bit, as one call),
-  // with a stop check between blocks.
-  static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex, const std::atomic<bool>* stop) {
+  // with a stop check between blocks (*info: the model, when asked for).
+  static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex, const std::atomic<bool>* stop,
+                              ModelInfo* info = nullptr) {
     constexpr std::size_t kBlock = 512;
     p.loop.floor_peaks = false;
     std::unique_ptr<Engine> e = build(s, p);
+    if (info) *info = e->info();
     e->init(ex.samples[0]);
     for (std::size_t k = 1; k < ex.samples.size(); k += kBlock) {
       stop_point(stop);
@@ -195,7 +202,8 @@ RunResult run_one(const SweepSpec& spec, const RunPlan& plan, const std::vector<
     if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
         p.device.vines.tau_s == 0.0)
       p.device.vines.tau_s = cache.tau(run);
-    const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop);
+    ModelInfo info;
+    const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop, &info);
     const RunTotals& b = *cache.bare(run);
     r.peak_top = t.peak_top;
     r.elastic_energy = t.elastic_energy;
@@ -203,7 +211,16 @@ RunResult run_one(const SweepSpec& spec, const RunPlan& plan, const std::vector<
     r.E_r = reduction(b.elastic_energy, t.elastic_energy);
     r.residual = t.ledger.relative_residual();
     r.contacts = t.count.contacts;
+    // The guards of both runs, and the status (a device run is compared with its bare frame).
+    const bool device = p.device.kind != DeviceKind::kNone;
     r.cap_hits = t.count.cap_hits;
+    r.bad_samples = t.count.bad_samples + (device ? b.count.bad_samples : 0);
+    r.divergences = t.count.divergences + (device ? b.count.divergences : 0);
+    r.max_overlap = t.max_overlap;
+    r.energy_checked = p.loop.energy_ledger;
+    const RunStatus status = device_status(t, device ? &b : nullptr, p, info, run.scene.scalar);
+    r.degraded = !status.ok();
+    r.degraded_reasons = status.codes();
   } catch (const std::exception& e) {
     r.error = e.what();
   }
@@ -229,8 +246,9 @@ json stats_json(const std::optional<Stats>& s) {
   return {{"mean", s->mean}, {"sd", s->sd}, {"min", s->min}, {"max", s->max}, {"n", s->n}};
 }
 
-// A study's statistics: over all its finished runs, and per value of
-// group_by (or of its single grid key when it optimises).
+// A study's statistics: over its finished runs that are ok (degraded ones
+// counted apart), and per value of group_by (or of its single grid key when
+// it optimises).
 StudySummary summarize_study(const SweepSpec& spec, int s, const std::vector<RunPlan>& plan,
                              const std::vector<RunResult>& results) {
   const StudySpec& st = spec.studies[s];
@@ -238,33 +256,41 @@ StudySummary summarize_study(const SweepSpec& spec, int s, const std::vector<Run
   out.name = st.name;
   out.scene = st.scene_path;
   out.optimize = st.optimize;
-  std::vector<double> xr, er;
-  std::map<double, std::pair<std::vector<double>, std::vector<double>>> groups;
+  struct Figures {
+    std::vector<double> xr, er;
+    std::size_t degraded = 0;
+    void add(const RunResult& r) {
+      if (r.degraded) return void(++degraded);
+      xr.push_back(r.x_r);
+      er.push_back(r.E_r);
+    }
+  };
+  Figures all;
+  std::map<double, Figures> groups;
   const std::string gkey = !st.group_by.empty() ? st.group_by
                            : (!st.optimize.empty() && st.grid_axes.size() == 1) ? st.grid_axes[0].front().key
                                                                                   : "";
   for (std::size_t i = 0; i < plan.size(); ++i) {
     if (plan[i].study != s || !results[i].done || !results[i].error.empty()) continue;
-    xr.push_back(results[i].x_r);
-    er.push_back(results[i].E_r);
+    all.add(results[i]);
     out.device = results[i].device;
+    out.energy_checked &= results[i].energy_checked;
     for (const KeyValue& v : plan[i].values)
-      if (v.key == gkey) {
-        groups[v.number].first.push_back(results[i].x_r);
-        groups[v.number].second.push_back(results[i].E_r);
-      }
+      if (v.key == gkey) groups[v.number].add(results[i]);
   }
-  out.runs = xr.size();
-  out.x_r = stats(xr);
-  out.E_r = stats(er);
+  out.runs = all.xr.size() + all.degraded;
+  out.degraded = all.degraded;
+  out.x_r = stats(all.xr);
+  out.E_r = stats(all.er);
   if (groups.empty()) return out;
   out.group_by = gkey;
   out.best = -1e300;
+  // The best group: of the best mean over its ok runs.
   for (auto& [value, g] : groups) {
-    out.groups.push_back({value, *stats(g.first), *stats(g.second)});
-    const double m = (st.optimize == "E_r" ? out.groups.back().E_r : out.groups.back().x_r).mean;
-    if (m > out.best) {
-      out.best = m;
+    out.groups.push_back({value, stats(g.xr), stats(g.er), g.degraded});
+    const std::optional<Stats>& m = st.optimize == "E_r" ? out.groups.back().E_r : out.groups.back().x_r;
+    if (m && m->mean > out.best) {
+      out.best = m->mean;
       out.best_value = value;
     }
   }
@@ -283,7 +309,8 @@ void write_results_csv(const SweepSpec& spec, const std::vector<RunPlan>& plan, 
   csv.raw("study").raw("run").raw("device");
   for (const std::string& k : keys) csv.text(k);
   for (const char* h : {"x_r", "E_r", "peak_top_displacement_m", "elastic_energy_integral", "contacts",
-                        "energy_balance_residual", "substep_cap_hits", "error"})
+                        "energy_balance_residual", "substep_cap_hits", "bad_samples_held", "divergences_rolled_back",
+                        "max_overlap_m", "status", "degraded_reasons", "error"})
     csv.raw(h);
   csv.end_row();
   // One row per finished run; a failed one has its message in the last column.
@@ -297,11 +324,16 @@ void write_results_csv(const SweepSpec& spec, const std::vector<RunPlan>& plan, 
         if (v.column() == k) cell += v.label();
       csv.text(cell);
     }
+    // A residual not computed (loop.energy_ledger = false) is an empty cell.
     if (r.error.empty()) {
       csv.number(r.x_r, "%.10g").number(r.E_r, "%.10g").number(r.peak_top, "%.10g");
-      csv.number(r.elastic_energy, "%.10g").integer(r.contacts).number(r.residual, "%.3g").integer(r.cap_hits).empty();
+      csv.number(r.elastic_energy, "%.10g").integer(r.contacts);
+      if (r.energy_checked) csv.number(r.residual, "%.3g");
+      else csv.empty();
+      csv.integer(r.cap_hits).integer(r.bad_samples).integer(r.divergences).number(r.max_overlap, "%.6g");
+      csv.raw(r.degraded ? "degraded" : "ok").text(r.degraded_reasons).empty();
     } else {
-      for (int c = 0; c < 7; ++c) csv.empty();
+      for (int c = 0; c < 12; ++c) csv.empty();
       csv.quoted(r.error);
     }
     csv.end_row();
@@ -315,11 +347,13 @@ json SweepSummary::to_json() const {
   json js = json::array();
   for (const StudySummary& st : studies) {
     json j = {{"name", st.name}, {"scene", st.scene}, {"device", st.device}, {"runs", st.runs},
-              {"x_r", stats_json(st.x_r)}, {"E_r", stats_json(st.E_r)}};
+              {"x_r", stats_json(st.x_r)}, {"E_r", stats_json(st.E_r)}, {"degraded", st.degraded}};
+    if (!st.energy_checked) j["energy_balance"] = "not computed in every run (loop.energy_ledger = false)";
     if (!st.groups.empty()) {
       json jg = json::array();
       for (const GroupSummary& g : st.groups)
-        jg.push_back({{"value", g.value}, {"x_r", stats_json(g.x_r)}, {"E_r", stats_json(g.E_r)}});
+        jg.push_back({{"value", g.value}, {"x_r", stats_json(g.x_r)}, {"E_r", stats_json(g.E_r)},
+                      {"degraded", g.degraded}});
       j["group_by"] = st.group_by;
       j["groups"] = jg;
       if (!st.optimize.empty()) j["best"] = {{"key", st.group_by}, {"value", st.best_value}, {st.optimize, st.best}};
@@ -328,7 +362,7 @@ json SweepSummary::to_json() const {
   }
   return {{"spec", spec},   {"runs", runs},           {"done", done},
           {"failed", failed}, {"complete", done == runs}, {"wall_time_s", wall_s},
-          {"runs_per_s", runs_per_s()}, {"studies", js}};
+          {"runs_per_s", runs_per_s()}, {"studies", js}, {"degraded", degraded}};
 }
 
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
@@ -362,6 +396,7 @@ SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan
   for (const RunResult& r : results) {
     s.done += r.done;
     s.failed += r.done && !r.error.empty();
+    s.degraded += r.done && r.error.empty() && r.degraded;
   }
   for (int i = 0; i < static_cast<int>(spec.studies.size()); ++i)
     s.studies.push_back(summarize_study(spec, i, plan, results));

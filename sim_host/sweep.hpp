@@ -58,11 +58,20 @@ struct RunResult {
   std::string device;
   double x_r = 0, E_r = 0, peak_top = 0, elastic_energy = 0, residual = 0;
   long long contacts = 0, cap_hits = 0;
+  // The run's guards and limits (either run: the device's or its bare
+  // frame's), and its status (sim_host/status.hpp): degraded runs are kept
+  // out of the statistics and counted apart.
+  long long bad_samples = 0, divergences = 0;
+  double max_overlap = 0;
+  bool energy_checked = false;      // residual was computed (loop.energy_ledger)
+  bool degraded = false;
+  std::string degraded_reasons;     // codes joined with ';' ("" when ok)
 };
 // A result as JSON (a line of DIR/runs.jsonl, sweep_log.hpp): every member,
 // by name; a member missing from the JSON keeps its default.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunResult, done, error, device, x_r, E_r, peak_top, elastic_energy,
-                                                residual, contacts, cap_hits)
+                                                residual, contacts, cap_hits, bad_samples, divergences, max_overlap,
+                                                energy_checked, degraded, degraded_reasons)
 
 struct StudySpec {
   std::string name, scene_path, group_by, optimize;
@@ -112,13 +121,16 @@ struct Stats {
 // The runs of a study with one value of its group key.
 struct GroupSummary {
   double value = 0;
-  Stats x_r, E_r;
+  std::optional<Stats> x_r, E_r;  // none when every run of the group is degraded
+  std::size_t degraded = 0;
 };
 
 struct StudySummary {
   std::string name, scene, device;
-  std::size_t runs = 0;                 // finished without error
-  std::optional<Stats> x_r, E_r;        // none when no run finished
+  std::size_t runs = 0;                 // finished without error (ok and degraded)
+  std::size_t degraded = 0;             // of which degraded: not in the statistics
+  std::optional<Stats> x_r, E_r;        // over the ok runs; none when there is none
+  bool energy_checked = true;           // every run computed its energy balance
   std::string group_by;                 // the group key ("": no groups)
   std::vector<GroupSummary> groups;     // by value
   std::string optimize;                 // "", "x_r" or "E_r"
@@ -128,7 +140,7 @@ struct StudySummary {
 // summary.json of a sweep.
 struct SweepSummary {
   std::string spec;
-  std::size_t runs = 0, done = 0, failed = 0;
+  std::size_t runs = 0, done = 0, failed = 0, degraded = 0;
   double wall_s = 0;
   std::vector<StudySummary> studies;
   double runs_per_s() const { return wall_s > 0 ? done / wall_s : 0.0; }

@@ -14,9 +14,11 @@ namespace {
 
 // A finished run as plain bytes.
 struct Packed {
-  std::int64_t index, contacts, cap_hits;
-  double x_r, E_r, peak_top, elastic_energy, residual;
+  std::int64_t index, contacts, cap_hits, bad_samples, divergences;
+  double x_r, E_r, peak_top, elastic_energy, residual, max_overlap;
+  bool energy_checked, degraded;
   char device[8];
+  char degraded_reasons[320];  // every code of both runs fits
   char error[224];
 };
 
@@ -34,6 +36,11 @@ void copy_numbers(const From& from, To* to) {
   to->peak_top = from.peak_top;
   to->elastic_energy = from.elastic_energy;
   to->residual = from.residual;
+  to->bad_samples = from.bad_samples;
+  to->divergences = from.divergences;
+  to->max_overlap = from.max_overlap;
+  to->energy_checked = from.energy_checked;
+  to->degraded = from.degraded;
 }
 
 }  // namespace
@@ -60,6 +67,7 @@ void Mpi::gather(std::vector<RunResult>* results) const {
     p.index = static_cast<std::int64_t>(i);
     copy_numbers(r, &p);
     std::strncpy(p.device, r.device.c_str(), sizeof p.device - 1);
+    std::strncpy(p.degraded_reasons, r.degraded_reasons.c_str(), sizeof p.degraded_reasons - 1);
     std::strncpy(p.error, r.error.c_str(), sizeof p.error - 1);
     mine.push_back(p);
   }
@@ -82,6 +90,7 @@ void Mpi::gather(std::vector<RunResult>* results) const {
     r.done = true;
     copy_numbers(p, &r);
     r.device = p.device;
+    r.degraded_reasons = p.degraded_reasons;
     r.error = p.error;
   }
 }

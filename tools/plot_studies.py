@@ -93,9 +93,14 @@ def load(path, studies):
     failed = [r for r in rows if r.get("error")]
     if failed:
         note(f"{csv_path}: skipping {len(failed)} failed run(s)")
+    # Degraded runs (status column, docs/model.md "Run status") are left out as the summary does.
+    degraded = [r for r in rows if r.get("status") == "degraded"]
+    if degraded:
+        note(f"{csv_path}: skipping {len(degraded)} degraded run(s)")
     by_name = {}
     for r in rows:
-        if not r.get("error") and np.isfinite(num(r["x_r"])) and np.isfinite(num(r["E_r"])):
+        if (not r.get("error") and r.get("status", "ok") != "degraded" and np.isfinite(num(r["x_r"]))
+                and np.isfinite(num(r["E_r"]))):
             by_name.setdefault(r["study"], []).append(r)
     for name, rs in by_name.items():
         if name in studies:

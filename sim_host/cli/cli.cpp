@@ -25,6 +25,11 @@ CLI::App* add_command(CLI::App& vines, const std::string& name, const std::strin
   return cmd;
 }
 
+CLI::Option* add_accept_degraded(CLI::App& cmd, bool* accept) {
+  return cmd.add_flag("--accept-degraded", *accept,
+                      "exit 0 when results are degraded (they are still marked so; default: exit status 3)");
+}
+
 namespace {
 
 // "a,b,c" -> *xs: every item a finite number > 0 (with whole: an integer from

@@ -16,6 +16,7 @@ namespace vines::cli {
 inline constexpr int kOk = 0;
 inline constexpr int kRefused = 1;       // refused input: bad scene or file, a run that failed
 inline constexpr int kUsage = 2;         // unknown option, bad option value, missing argument
+inline constexpr int kDegraded = 3;      // finished, but a result is degraded (--accept-degraded: 0)
 inline constexpr int kInterrupted = 130; // Ctrl-C
 
 // Adds `vines NAME`: `summary` says what it does (in `vines help` and atop its
@@ -40,6 +41,15 @@ CLI::Validator number_in(double lo, double hi);
 CLI::Validator positive_up_to(double hi);
 // Check of a file or folder option (--out, --csv): not an empty path.
 CLI::Validator non_empty_path();
+
+// The exit status of finished results: kOk, or kDegraded when any is degraded
+// and the user did not pass --accept-degraded.
+inline int finished_status(bool degraded, bool accept_degraded) {
+  return degraded && !accept_degraded ? kDegraded : kOk;
+}
+
+// Adds --accept-degraded to a command (exit 0 with degraded results).
+CLI::Option* add_accept_degraded(CLI::App& cmd, bool* accept);
 
 // Ctrl-C from now on sets the returned flag (runs under way stop at their
 // next check, within a second; the command keeps what finished, status

@@ -37,9 +37,17 @@ int design(DesignArgs a) {
   }
   write_file_atomic(out.file("design.json"), r.to_json().dump(2) + '\n');
   out.finish({"design.json"});
+  // The best value is of an ok run; degraded values were not candidates.
+  if (!r.found) {
+    std::fprintf(stderr, "vines design: DEGRADED: every one of the %zu values tried has a degraded run (reasons in "
+                 "%s/design.json); no best value\n", r.evaluations.size(), a.out_dir.c_str());
+    return kDegraded;
+  }
   std::printf("design %s: best %s = %.6g, %s %s = %.2f %% (%zu evaluations; %s/design.json)\n", scene.name.c_str(),
               opt.key.c_str(), r.best_value, opt.objective.c_str(), opt.metric.c_str(), 100 * r.best_objective,
               r.evaluations.size(), a.out_dir.c_str());
+  if (r.degraded() > 0)
+    std::printf("  %zu values with a degraded run were not candidates (reasons in design.json)\n", r.degraded());
   return kOk;
 }
 
@@ -51,7 +59,9 @@ void add_design(CLI::App& vines) {
   CLI::App* cmd = add_command(vines, "design",
                               "Best value of one design parameter for the scene's record or a set of records (mean "
                               "or worst case): coarse grid, then golden-section refinement.",
-                              "Ctrl-C stops the search after the runs under way; nothing is written (exit status 130).",
+                              "A value with a degraded run cannot be the best; when every value is degraded there is "
+                              "no best (exit status 3). Ctrl-C stops the search after the runs under way; nothing is "
+                              "written (exit status 130).",
                               [a] { return design(*a); });
   cmd->add_option("SCENE.toml", opt.scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--optimize", a->name,

@@ -16,6 +16,7 @@ struct RunArgs {
   std::string scene_path;
   host::RunOptions opt;
   const CLI::Option* out = nullptr;  // --out, given or not
+  bool accept_degraded = false;
 };
 
 int run(RunArgs a) {
@@ -39,23 +40,19 @@ int run(RunArgs a) {
                   static_cast<long long>(k.contact_substeps));
     if (p.loop.energy_ledger)
       std::printf("  energy balance residual %.2e (relative)\n", r.totals.ledger.relative_residual());
+    else
+      std::printf("  energy balance not computed (loop.energy_ledger = false)\n");
     std::printf("  loop wall time %.2f ms; results in %s/\n", 1e3 * r.wall_s, opt.out_dir.c_str());
+    if (r.status.ok()) std::printf("  status: ok\n");
   }
-  // Limits the loop ran into are reported, never silent (even with --quiet).
-  const vines::LoopParams& loop = p.loop;
-  const auto cap_hits = static_cast<long long>(k.cap_hits);
-  if (cap_hits > 0 && loop.contact_scheme == vines::ContactScheme::kAdaptive)
-    std::fprintf(stderr, "vines run: warning: %lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): "
-                 "contacts in them are not resolved\n",
-                 cap_hits, loop.max_substeps_per_step);
-  if (cap_hits > 0 && loop.contact_scheme == vines::ContactScheme::kBounded)
-    std::fprintf(stderr, "vines run: warning: in %lld steps the sub-step budget (loop.bounded_substeps = %d) "
-                 "could not follow every event: they were deferred to the next step or stepped over\n",
-                 cap_hits, loop.bounded_substeps);
-  if (k.divergences + k.bad_samples > 0)
-    std::fprintf(stderr, "vines run: warning: %lld diverging steps rolled back, %lld non-finite samples held\n",
-                 static_cast<long long>(k.divergences), static_cast<long long>(k.bad_samples));
-  return kOk;
+  // A degraded result is reported with its reasons, never silent (even with --quiet).
+  if (!r.status.ok()) {
+    std::fflush(stdout);  // after the summary, when both go to one place
+    std::fprintf(stderr, "vines run: status: DEGRADED\n");
+    for (const StatusReason& why : r.status.reasons)
+      std::fprintf(stderr, "  %s: %s\n", why.code.c_str(), why.message.c_str());
+  }
+  return finished_status(!r.status.ok(), a.accept_degraded);
 }
 
 }  // namespace
@@ -77,7 +74,8 @@ void add_run(CLI::App& vines) {
                            "removed (default: out/<scene name>)")
                ->type_name("DIR")
                ->check(non_empty_path());
-  cmd->add_flag("--quiet", a->opt.quiet, "print nothing but errors");
+  cmd->add_flag("--quiet", a->opt.quiet, "print nothing but errors and a degraded status");
+  add_accept_degraded(*cmd, &a->accept_degraded);
 }
 
 }  // namespace vines::cli

@@ -43,9 +43,10 @@ std::string design_cell(bool vines, double v, std::size_t width) {
 void print_stress(const host::StressSummary& s, const host::StressRun& run,
                   const std::vector<host::StressRecord>& records, int threads) {
   using namespace vines::host;
-  std::printf("stress: %zu cases (seed %llu), %zu refused at load, %zu failed; %.1f s, %.0f cases/s, %d thread%s\n",
-              s.cases, static_cast<unsigned long long>(s.seed), s.refused, s.failed, s.wall_s, s.cases_per_s(),
-              threads, threads > 1 ? "s" : "");
+  std::printf("stress: %zu cases (seed %llu), %zu refused at load, %zu failed, %zu degraded; %.1f s, %.0f cases/s, "
+              "%d thread%s\n",
+              s.cases, static_cast<unsigned long long>(s.seed), s.refused, s.failed, s.degraded, s.wall_s,
+              s.cases_per_s(), threads, threads > 1 ? "s" : "");
   std::printf("\n%-12s %6s %7s %12s %12s\n", "check", "runs", "failed", "worst", "bound");
   for (int c : checks_by_name()) {
     const CheckSummary& k = s.checks[static_cast<std::size_t>(c)];

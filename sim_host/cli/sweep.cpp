@@ -29,6 +29,7 @@ struct SweepArgs {
   bool large = false;
   host::SweepOptions opt;
   const CLI::Option* out = nullptr;  // --out, given or not
+  bool accept_degraded = false;
 };
 
 std::string duration_text(double s) {
@@ -123,16 +124,20 @@ int sweep(SweepArgs a) {
   // The rate of the runs run now (a resumed sweep read the others from its log).
   const std::size_t ran = s.done - resumed;
   const std::string from_log = resumed > 0 ? " (" + std::to_string(resumed) + " from the log)" : "";
-  std::printf("sweep %s: %zu of %zu runs%s in %.2f s (%.1f runs/s, %d rank%s), %zu failed; results in %s/\n",
+  std::printf("sweep %s: %zu of %zu runs%s in %.2f s (%.1f runs/s, %d rank%s), %zu failed, %zu degraded; results "
+              "in %s/\n",
               a.spec_path.c_str(), s.done, plan.size(), from_log.c_str(), wall, wall > 0 ? ran / wall : 0.0,
-              mpi.size(), mpi.size() > 1 ? "s" : "", s.failed, opt.out_dir.c_str());
-  // A line per study that has results: x_r and E_r, and the best value.
+              mpi.size(), mpi.size() > 1 ? "s" : "", s.failed, s.degraded, opt.out_dir.c_str());
+  // A line per study that has results: x_r and E_r over its ok runs, the best value, the degraded runs.
   for (const StudySummary& st : s.studies) {
-    if (!st.x_r) continue;
-    std::printf("  %-24s %-5s n=%-5zu x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", st.name.c_str(),
-                st.device.c_str(), st.runs, 100 * st.x_r->mean, 100 * st.x_r->sd, 100 * st.x_r->min,
-                100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
+    if (st.runs == 0) continue;
+    std::printf("  %-24s %-5s n=%-5zu", st.name.c_str(), st.device.c_str(), st.runs - st.degraded);
+    if (st.x_r)
+      std::printf(" x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", 100 * st.x_r->mean,
+                  100 * st.x_r->sd, 100 * st.x_r->min, 100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
     if (!st.optimize.empty() && !st.groups.empty()) std::printf("  best %s = %g", st.group_by.c_str(), st.best_value);
+    if (st.degraded > 0) std::printf("  (%zu degraded, not counted)", st.degraded);
+    if (!st.energy_checked) std::printf("  (energy balance not computed)");
     std::printf("\n");
   }
   if (*stop) {
@@ -142,7 +147,11 @@ int sweep(SweepArgs a) {
                  opt.out_dir.c_str(), s.done, plan.size(), a.spec_path.c_str(), opt.out_dir.c_str());
     return kInterrupted;
   }
-  return s.failed == 0 ? kOk : kRefused;
+  if (s.failed > 0) return kRefused;
+  if (s.degraded > 0)
+    std::fprintf(stderr, "vines sweep: %zu runs DEGRADED (their status and reasons in %s/results.csv)\n", s.degraded,
+                 opt.out_dir.c_str());
+  return finished_status(s.degraded > 0, a.accept_degraded);
 }
 
 }  // namespace
@@ -176,6 +185,7 @@ void add_sweep(CLI::App& vines) {
       ->excludes("--out");
   cmd->add_flag("--large", a->large, "run a plan of more than 1000000 runs");
   cmd->add_flag_callback("--no-progress", [a] { a->opt.progress = false; }, "no progress bar / lines on stderr (nor the size and time of a sweep over a minute)");
+  add_accept_degraded(*cmd, &a->accept_degraded);
 }
 
 }  // namespace vines::cli
