@@ -34,8 +34,9 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
   std::vector<long long> restarts;
   for (const FaultEvent& e : events)
     if (e.kind == FaultKind::kRestart) restarts.push_back(e.k);
-  const std::vector<link::Telemetry> lives =
-      restarts.empty() ? std::vector<link::Telemetry>{} : offline_run(offline_cfg, b.ex.samples, b.scene.path, restarts);
+  const std::vector<link::Telemetry> lives = restarts.empty()
+                                                 ? std::vector<link::Telemetry>{}
+                                                 : offline_run(offline_cfg, b.ex.samples, b.scene.path, restarts);
   // Its score, the mode's results and the CSV.
   HilReport report = score(b, rec, offline, restarts.empty() ? offline : lives, &events);
   mode->report(rec, offline, &report);
