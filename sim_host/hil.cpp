@@ -28,9 +28,17 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
   const std::unique_ptr<BenchMode> mode = make_mode(b, offline);
   // Which faults hit which samples, drawn from the seed.
   std::vector<FaultEvent> events = plan_faults(b.opt, b.samples);
-  // The run, then its score, the mode's results and the CSV.
+  // The run; what a node that restarted should have given: the clean run of
+  // each of its lives, from rest at its restart (the offline run if none).
   const HilRecord rec = stream(b, *mode, &events);
-  HilReport report = score(b, rec, offline, &events);
+  std::vector<long long> restarts;
+  for (const FaultEvent& e : events)
+    if (e.kind == FaultKind::kRestart) restarts.push_back(e.k);
+  const std::vector<link::Telemetry> lives = restarts.empty()
+                                                 ? std::vector<link::Telemetry>{}
+                                                 : offline_run(offline_cfg, b.ex.samples, b.scene.path, restarts);
+  // Its score, the mode's results and the CSV.
+  HilReport report = score(b, rec, offline, restarts.empty() ? offline : lives, &events);
   mode->report(rec, offline, &report);
   if (!b.opt.csv.empty()) write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h);
   return report;

@@ -43,10 +43,12 @@ FaultSpec parse_fault_spec(const std::string& option, const std::string& value) 
 std::vector<FaultEvent> plan_faults(const HilOptions& opt, long long samples) {
   std::mt19937_64 rng(opt.seed);
   std::uniform_real_distribution<double> u(0, 1);
+  // Per sample: 0 free, kGap the recovery sample after a fault's window, kHit
+  // inside a fault's window.
+  constexpr char kGap = 1, kHit = 2;
   std::vector<char> busy(static_cast<std::size_t>(samples) + 1, 0);
   std::vector<FaultEvent> out;
-  // Windows: how many samples a fault occupies (nothing else may fall there)
-  // and how many must follow it before the end of the record.
+  // Windows: how many samples a fault occupies (nothing else may fall there).
   auto span_of = [&](FaultKind k) {
     switch (k) {
       case FaultKind::kStall: return opt.stall_periods;
@@ -63,12 +65,18 @@ std::vector<FaultEvent> plan_faults(const HilOptions& opt, long long samples) {
       const bool listed = std::find(s.at.begin(), s.at.end(), k) != s.at.end();
       const bool drawn = s.rate > 0 && u(rng) < s.rate;
       if (!listed && !drawn) continue;
+      // A fault the user made certain (listed, or a rate of 1) may take the
+      // recovery sample after another fault and may end with the record; a
+      // drawn one leaves a free sample after its window, before the end.
+      const bool certain = listed || s.rate >= 1;
       const int span = span_of(kind);
-      if (k + span + 1 >= samples) continue;
+      if (certain ? k + span > samples : k + span + 1 >= samples) continue;
       bool free = true;
-      for (long long j = k; j <= k + span && free; ++j) free = !busy[static_cast<std::size_t>(j)];
+      for (long long j = k; j <= std::min(k + span, samples - 1) && free; ++j)
+        free = busy[static_cast<std::size_t>(j)] == 0 || (certain && busy[static_cast<std::size_t>(j)] == kGap);
       if (!free) continue;
-      for (long long j = k; j <= k + span; ++j) busy[static_cast<std::size_t>(j)] = 1;
+      for (long long j = k; j < k + span; ++j) busy[static_cast<std::size_t>(j)] = kHit;
+      busy[static_cast<std::size_t>(k + span)] = std::max(busy[static_cast<std::size_t>(k + span)], kGap);
       FaultEvent ev;
       ev.kind = kind;
       ev.k = k;

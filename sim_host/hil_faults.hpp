@@ -1,6 +1,9 @@
 // The bench's fault plan: which samples get which fault, drawn once from the
 // options (rates with a seeded generator, or given samples), one fault per
-// sample and none inside another fault's window.
+// sample (the first kind in FaultKind's order that hits it) and none inside
+// another fault's window. A rate r hits each sample with probability r; a
+// drawn fault leaves one free sample after its window, a certain one (listed,
+// or rate 1) does not, so a rate of 1 hits every sample after the first.
 #pragma once
 
 #include <vector>
@@ -20,7 +23,7 @@ struct FaultEvent {
 };
 
 // Faults for samples 1 .. samples-1, in sample order. Windows that would run
-// past the end are not drawn.
+// past the end are not placed.
 std::vector<FaultEvent> plan_faults(const HilOptions& opt, long long samples);
 
 }  // namespace vines::host

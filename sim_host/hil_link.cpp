@@ -39,6 +39,24 @@ void NodeLink::send(const std::vector<std::uint8_t>& bytes) {
 }
 
 void NodeLink::pump(double timeout_s) {
+  const bool open = read(timeout_s);
+  // A node ends after answering STOP; before that, an exit is a failure.
+  if (!open && acked_ < delimiters_)
+    throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) +
+                             ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
+}
+
+void NodeLink::kill() {
+  child_.kill_now();
+  // What it sent before it died is still in the pipe: read until the pipe
+  // ends, or 0.1 s without a byte (a program that left the pipe open).
+  for (std::size_t n = 1; n > 0;) {
+    if (!read(0.1)) break;
+    n = buf_.size();
+  }
+}
+
+bool NodeLink::read(double timeout_s) {
   buf_.clear();
   const bool open = child_.read_some(&buf_, timeout_s);
   const double now = seconds_since(t0_);
@@ -69,10 +87,7 @@ void NodeLink::pump(double timeout_s) {
       ++bad_frames_;
     }
   }
-  // A node ends after answering STOP; before that, an exit is a failure.
-  if (!open && acked_ < delimiters_)
-    throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) +
-                             ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
+  return open;
 }
 
 void NodeLink::wait_answered(std::uint32_t in_flight) {

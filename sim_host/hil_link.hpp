@@ -55,11 +55,14 @@ class NodeLink {
   bool first_cold_start() const { return first_cold_start_; }
   long long bad_frames() const { return bad_frames_; }
   void set_epoch(HilClock::time_point t0) { t0_ = t0; }
-  void kill() { child_.kill_now(); }
+  // Kills the node, then reads what it had sent.
+  void kill();
   int finish() { return child_.finish(opt_.timeout_s); }
 
  private:
   static std::vector<std::string> argv(const HilOptions& opt);
+  // Reads and dispatches what came within timeout_s; false once the pipe ended.
+  bool read(double timeout_s);
 
   const HilOptions& opt_;
   long long life_;

@@ -15,19 +15,28 @@ std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::st
 }
 
 std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
-                                         const std::string& what) {
-  HostPlant plant;
-  char msg[64] = {};
+                                         const std::string& what, const std::vector<long long>& starts) {
   const std::vector<std::uint8_t> image = model_image(cfg, what);
-  plant.image_begin(static_cast<std::uint32_t>(image.size()));
-  plant.image_push(image.data(), image.size());
-  if (!plant.configure(cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
   std::vector<link::Telemetry> out(samples.size());
-  plant.init(samples[0], 0);
-  plant.read(&out[0]);
-  for (std::size_t k = 1; k < samples.size(); ++k) {
-    plant.step(samples[k], 0);
-    plant.read(&out[k]);
+  const auto n = static_cast<long long>(samples.size());
+  // One life from each start (the first at 0) to the next: a fresh plant.
+  std::vector<long long> from = {0};
+  for (long long k : starts)
+    if (k > from.back() && k < n) from.push_back(k);
+  from.push_back(n);
+  for (std::size_t i = 0; i + 1 < from.size(); ++i) {
+    HostPlant plant;
+    char msg[64] = {};
+    plant.image_begin(static_cast<std::uint32_t>(image.size()));
+    plant.image_push(image.data(), image.size());
+    if (!plant.configure(cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
+    const auto k0 = static_cast<std::size_t>(from[i]);
+    plant.init(samples[k0], 0);
+    plant.read(&out[k0]);
+    for (auto k = k0 + 1; k < static_cast<std::size_t>(from[i + 1]); ++k) {
+      plant.step(samples[k], 0);
+      plant.read(&out[k]);
+    }
   }
   return out;
 }

@@ -17,8 +17,10 @@ namespace vines::host {
 std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what);
 
 // The offline run: the scene's engine stepped in this process, read exactly
-// as the node reads it (HostPlant), so equal code gives equal bits.
+// as the node reads it (HostPlant), so equal code gives equal bits. With
+// `starts` (a restarted node's first samples, ascending), a fresh plant from
+// rest at each, as the restarted node does: the clean run of each node life.
 std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
-                                         const std::string& what);
+                                         const std::string& what, const std::vector<long long>& starts = {});
 
 }  // namespace vines::host

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "vines/link/messages.hpp"
@@ -14,7 +15,17 @@ struct HilRecord {
   // lab: keep the hybrid mode's table and load cell too.
   HilRecord(long long count, bool lab)
       : samples(count), sensed(n()), clipped(n(), 0), tel(n()), got(n(), 0), arrival(n(), 0), handled(n(), 0),
-        table_x(lab ? n() : 0, 0), force(lab ? n() : 0, 0) {}
+        sent(n(), 0), sent_life(n(), -1), tel_life(n(), -1), table_x(lab ? n() : 0, 0), force(lab ? n() : 0, 0) {}
+
+  // Sample k's latency [s]: its telemetry's arrival minus the sending of its
+  // frame, when the node stepped it from that frame (not held, not
+  // interpolated) in the same life; none otherwise.
+  std::optional<double> latency(long long k) const {
+    const auto i = static_cast<std::size_t>(k);
+    if (!got[i] || tel_life[i] != sent_life[i] || (tel[i].flags & (link::kInterpolated | link::kHeld)))
+      return std::nullopt;
+    return arrival[i] - sent[i];
+  }
 
   long long samples;
   // The samples as the sensor gives them (clipped at its range), and which were clipped.
@@ -25,6 +36,10 @@ struct HilRecord {
   std::vector<link::Telemetry> tel;
   std::vector<char> got;
   std::vector<double> arrival, handled;
+  // Each sample's first sending to a node, that node's life (-1: never sent),
+  // and the life of the node whose telemetry it is (a restart starts life+1).
+  std::vector<double> sent;
+  std::vector<long long> sent_life, tel_life;
   // The node's fault messages and the node process (life) each came from.
   std::vector<link::Fault> faults;
   std::vector<long long> fault_life;

@@ -67,7 +67,12 @@ json to_json(const HilReport& r) {
   j["faults_survived"] = r.faults_survived;
   j["faults"] = json::object();
   for (const auto& [name, c] : r.faults)
-    j["faults"][name] = {{"injected", c.injected}, {"detected", c.detected}, {"survived", c.survived}};
+    j["faults"][name] = {{"injected", c.injected},       {"detected", c.detected},
+                         {"survived", c.survived},       {"verdict", c.ok ? "survived" : "not survived"},
+                         {"deviation_m", c.deviation_m}, {"bound_m", c.bound_m},
+                         {"unanswered", c.unanswered}};
+  j["survived"] = r.survived;
+  j["survival_bound_m"] = r.survival_bound_m;
   j["node_faults"] = json::object();
   for (const auto& [name, count] : r.node_faults) j["node_faults"][name] = count;
   j["node_restarts"] = r.node_restarts;
@@ -117,7 +122,7 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
     const link::Telemetry& t = rec.tel[k];
     const bool got = rec.got[k];
     f.integer(k).number(static_cast<double>(k) * h, "%.6f").number(rec.sensed[k], kFull).number(t.ag, kFull);
-    f.integer(got ? 1 : 0).integer(t.flags).number(got ? 1e6 * (rec.arrival[k] - rec.handled[k]) : 0.0, "%.1f");
+    f.integer(got ? 1 : 0).integer(t.flags).number(1e6 * rec.latency(k).value_or(0.0), "%.1f");
     f.number(t.x[n - 1], kFull).number(offline[k].x[n - 1], kFull);
     f.number(got ? std::fabs(t.x[n - 1] - offline[k].x[n - 1]) : 0.0, "%.3g");
     for (double v : {t.acc_top, t.elastic_energy, t.particle_x, t.contact_force, t.dissipated, t.aux}) f.number(v, kFull);

@@ -25,9 +25,16 @@ struct HilStats {
   double mean = 0, p50 = 0, p99 = 0, max = 0;
 };
 
-// Faults of one kind: how many were injected, detected by the node, survived.
+// Faults of one kind: how many were injected, detected by the node, survived
+// (all or none: the kind is judged as a whole, docs/link_protocol.md), and
+// the verdict's figures: the largest deviation of the top floor from the
+// clean run after the recovery windows, its bound, and the samples judged
+// that got no telemetry.
 struct HilFaultCounts {
   long long injected = 0, detected = 0, survived = 0;
+  bool ok = true;
+  double deviation_m = 0, bound_m = 0;
+  long long unanswered = 0;
 };
 
 // The node's last status: steps taken, state, and how its process ended.
@@ -83,6 +90,8 @@ struct HilReport {
   // Faults: injected by the bench (by kind), counted by the node (by code)
   long long faults_injected = 0, faults_detected = 0, faults_survived = 0;
   std::map<std::string, HilFaultCounts> faults;
+  bool survived = true;         // every kind survived (no faults: true)
+  double survival_bound_m = 0;  // the bound: the clean run's peak top-floor displacement
   std::map<std::string, long long> node_faults;
   long long node_restarts = 0, bad_frames_from_node = 0;
   // Against the offline run

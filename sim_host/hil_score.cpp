@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
 
 namespace vines::host {
 namespace {
@@ -56,10 +60,49 @@ bool seq_missing(const HilRecord& rec, const FaultEvent& e) {
   return false;
 }
 
-// Each event detected (the node's fault for it) and survived (the next 11
-// steps came, finite); the clipped samples as the kind "saturate".
-void score_faults(const Bench& b, const HilRecord& rec, std::vector<FaultEvent>* events, HilReport* r) {
+// The faults of one kind, each (first sample, samples it covers).
+using Hits = std::vector<std::pair<long long, long long>>;
+
+// A kind's verdict (docs/link_protocol.md, "Survived"): every telemetry from
+// its first fault on finite; on each sample from there outside the recovery
+// windows (a fault's samples, then --node-stall periods), telemetry came and
+// the top floor is within `bound` of `reference` (the clean run of the
+// node's life). Faults running to the end leave the last sample judged.
+void judge(const Bench& b, const HilRecord& rec, const std::vector<Telemetry>& reference, const Hits& hits,
+           double bound, HilFaultCounts* c) {
+  const long long K = rec.samples, recovery = static_cast<long long>(std::ceil(b.opt.node_stall_periods));
+  const int top = b.scene.params.frame.stories - 1;
+  long long first = K;
+  for (const auto& [k, span] : hits) first = std::min(first, k);
+  std::vector<char> judged(static_cast<std::size_t>(K), 0);
+  for (long long j = first; j < K; ++j) judged[j] = 1;
+  for (const auto& [k, span] : hits)
+    for (long long j = k; j < std::min(K, k + span + recovery); ++j) judged[j] = 0;
+  if (std::find(judged.begin(), judged.end(), 1) == judged.end()) judged[K - 1] = 1;
+  bool finite_all = true;
+  for (long long j = std::min(first, K - 1); j < K; ++j) {
+    if (rec.got[j] && !finite(b, rec.tel[j])) finite_all = false;
+    if (!judged[j]) continue;
+    if (!rec.got[j]) ++c->unanswered;
+    else c->deviation_m = std::max(c->deviation_m, std::fabs(rec.tel[j].x[top] - reference[j].x[top]));
+  }
+  if (!finite_all) c->deviation_m = std::numeric_limits<double>::infinity();
+  c->bound_m = bound;
+  c->ok = finite_all && c->unanswered == 0 && c->deviation_m <= bound;
+  c->survived = c->ok ? c->injected : 0;
+}
+
+// Each event detected (the node's fault for it); the clipped samples as the
+// kind "saturate"; each kind judged survived or not against the clean run's
+// peak top-floor displacement.
+void score_faults(const Bench& b, const HilRecord& rec, const std::vector<Telemetry>& offline,
+                  const std::vector<Telemetry>& reference, std::vector<FaultEvent>* events, HilReport* r) {
   const long long K = rec.samples;
+  const int top = b.scene.params.frame.stories - 1;
+  double bound = 0;
+  for (const Telemetry& t : offline) bound = std::max(bound, std::fabs(t.x[top]));
+  r->survival_bound_m = bound;
+  std::map<std::string, Hits> hits;
   for (FaultEvent& e : *events) {
     const unsigned s0 = e.seqs.empty() ? 0 : e.seqs[0];
     switch (e.kind) {
@@ -72,11 +115,9 @@ void score_faults(const Bench& b, const HilRecord& rec, std::vector<FaultEvent>*
       case FaultKind::kStall: e.detected = fault_seen(rec, e, link::FaultCode::kStall, e.k, e.k + e.span); break;
       default: break;
     }
-    e.survived = true;
-    const long long from = e.k + e.span + 1, to = std::min(K - 1, from + 10);
-    for (long long j = from; j <= to; ++j) e.survived = e.survived && rec.got[j] && finite(b, rec.tel[j]);
     HilFaultCounts& c = r->faults[fault_kind_name(e.kind)];
-    c.injected += 1, c.detected += e.detected, c.survived += e.survived;
+    c.injected += 1, c.detected += e.detected;
+    hits[fault_kind_name(e.kind)].emplace_back(e.k, e.span);
   }
   // Saturation counts on samples that reach the node on time and intact and
   // that it stepped (a clipped sample that is also dropped, late, ... is that
@@ -90,12 +131,16 @@ void score_faults(const Bench& b, const HilRecord& rec, std::vector<FaultEvent>*
   for (const link::Fault& f : rec.faults)
     clipped_seen += f.code == link::FaultCode::kSaturated && f.k < K && clipped[f.k] && rec.got[f.k];
   if (clipped_n > 0) {
-    long long survived = 1;
-    for (long long k = 0; k < K; ++k) survived &= !rec.got[k] || finite(b, rec.tel[k]);
-    r->faults["saturate"] = {clipped_n, clipped_seen, survived ? clipped_n : 0};
+    r->faults["saturate"] = {clipped_n, clipped_seen};
+    for (long long k = 0; k < K; ++k)
+      if (clipped[k] && rec.got[k]) hits["saturate"].emplace_back(k, 1);
   }
-  for (const auto& [name, c] : r->faults)
+  for (auto& [name, c] : r->faults) {
+    judge(b, rec, reference, hits[name], bound, &c);
+    r->survived = r->survived && c.ok;
     r->faults_injected += c.injected, r->faults_detected += c.detected, r->faults_survived += c.survived;
+  }
+  for (FaultEvent& e : *events) e.survived = r->faults[fault_kind_name(e.kind)].ok;
   for (int c = 0; c < link::kFaultCodes; ++c) {
     long long count = 0;
     for (const link::Fault& f : rec.faults) count += static_cast<int>(f.code) == c;
@@ -117,9 +162,12 @@ void score_steps(const Bench& b, const HilRecord& rec, const std::vector<Telemet
     ++r->steps;
     const Telemetry& t = rec.tel[k];
     // Real time: telemetry due by the sample's time plus the deadline; virtual
-    // clock: its latency (sample handled to telemetry back) within the deadline.
-    const double late = b.opt.realtime ? rec.arrival[k] - static_cast<double>(k) * h : rec.arrival[k] - rec.handled[k];
-    latency_us.push_back(1e6 * (rec.arrival[k] - rec.handled[k]));
+    // clock: its latency (sample sent to telemetry back; a step without its
+    // sample: from when the bench handled it) within the deadline.
+    const std::optional<double> latency = rec.latency(k);
+    const double late = b.opt.realtime ? rec.arrival[k] - static_cast<double>(k) * h
+                                       : latency.value_or(rec.arrival[k] - rec.handled[k]);
+    if (latency) latency_us.push_back(1e6 * *latency);
     // A board in QEMU keeps the board's time, not the host's: its deadline is
     // the step's cost on its counter against the budget (one period).
     if (b.board ? t.step_ticks > rec.final_status.timing.budget_ticks : late > deadline) ++r->deadline_misses;
@@ -159,7 +207,7 @@ void score_node(const Bench& b, const HilRecord& rec, HilReport* r) {
 }  // namespace
 
 HilReport score(const Bench& b, const HilRecord& rec, const std::vector<Telemetry>& offline,
-                std::vector<FaultEvent>* events) {
+                const std::vector<Telemetry>& reference, std::vector<FaultEvent>* events) {
   HilReport r;
   r.scene = b.scene.name;
   r.mode = b.opt.mode;
@@ -171,7 +219,7 @@ HilReport score(const Bench& b, const HilRecord& rec, const std::vector<Telemetr
   r.node_restarts = rec.restarts;
   r.bad_frames_from_node = rec.bad_frames;
   r.wall_time_s = rec.wall_s;
-  score_faults(b, rec, events, &r);
+  score_faults(b, rec, offline, reference, events, &r);
   score_steps(b, rec, offline, &r);
   score_node(b, rec, &r);
   return r;

@@ -38,7 +38,7 @@ class Stream {
     node_->set_epoch(t0_);
     start(*node_, 0, 0);
     for (long long k = 0; k < K_; ++k) step(k);
-    for (auto& r : releases_) node_->send(sample_frame(r.second, static_cast<double>(K_) * b_.h));
+    for (auto& r : releases_) send_sample(sample_frame(r.second, static_cast<double>(K_) * b_.h), r.second);
     node_->send(node_->encode_empty(link::MsgType::kStop));
     node_->wait_answered();
     rec_.final_status = node_->status();
@@ -51,13 +51,15 @@ class Stream {
  private:
   // A node process (life rec_.restarts) whose telemetry lands in the record.
   std::unique_ptr<NodeLink> new_node() {
-    auto n = std::make_unique<NodeLink>(o_, rec_.restarts, &rec_.faults, &rec_.fault_life);
+    const long long life = rec_.restarts;
+    auto n = std::make_unique<NodeLink>(o_, life, &rec_.faults, &rec_.fault_life);
     n->set_epoch(t0_);
-    n->on_telemetry = [this](const Telemetry& t, double now) {
+    n->on_telemetry = [this, life](const Telemetry& t, double now) {
       if (t.k >= static_cast<std::uint32_t>(K_)) return;
       rec_.tel[t.k] = t;
       rec_.got[t.k] = 1;
       rec_.arrival[t.k] = now;
+      rec_.tel_life[t.k] = life;
       mode_.on_telemetry(t);
     };
     return n;
@@ -75,10 +77,19 @@ class Stream {
     return node_->encode(link::MsgType::kSample, s);
   }
 
-  // Kills the node and starts a new one at sample k.
+  // Sends sample k's frame; its first sending to this node is the time its
+  // latency counts from.
+  void send_sample(const std::vector<std::uint8_t>& frame, long long k) {
+    node_->send(frame);
+    const auto i = static_cast<std::size_t>(k);
+    if (rec_.sent_life[i] != rec_.restarts) rec_.sent[i] = seconds_since(t0_), rec_.sent_life[i] = rec_.restarts;
+  }
+
+  // Kills the node (keeping what it sent before) and starts a new one at
+  // sample k.
   void restart(long long k, double due, FaultEvent* e) {
-    rec_.bad_frames += node_->bad_frames();
     node_->kill();
+    rec_.bad_frames += node_->bad_frames();
     ++rec_.restarts;
     node_ = new_node();
     configure(*node_, b_.cfg, b_.image);
@@ -98,17 +109,21 @@ class Stream {
       for (double left = due - seconds_since(t0_); left > 0; left = due - seconds_since(t0_))
         node_->pump(std::min(left, 0.002));
     }
-    const double now = o_.realtime ? seconds_since(t0_) : due;
+    // Real time: what the node sent meanwhile is read (a bench behind its
+    // schedule reads here only).
+    if (o_.realtime) node_->pump(0);
     rec_.handled[k] = seconds_since(t0_);
     FaultEvent* e = at_[static_cast<std::size_t>(k)];
     if (e) e->life = rec_.restarts;
     if (e && e->kind == FaultKind::kRestart) restart(k, due, e);
+    // The sample's stamp: after a restart in real time, the time it is sent.
+    const double now = o_.realtime ? seconds_since(t0_) : due;
     mode_.drive(k, &rec_);
     for (auto r = releases_.lower_bound(k); r != releases_.end() && r->first == k; r = releases_.erase(r))
-      node_->send(sample_frame(r->second, now));
+      send_sample(sample_frame(r->second, now), r->second);
     if (!reordered_.empty() && k == reordered_k_ + 1) {
-      node_->send(sample_frame(k, now));
-      node_->send(reordered_);
+      send_sample(sample_frame(k, now), k);
+      send_sample(reordered_, reordered_k_);
       reordered_.clear();
     } else if (e && e->kind == FaultKind::kStall) {
       for (long long j = k; j < k + e->span; ++j) releases_.emplace(k + e->span, j);
@@ -140,8 +155,8 @@ class Stream {
       reordered_ = f;
       reordered_k_ = k;
     } else if (kind != FaultKind::kDrop) {
-      node_->send(f);
-      if (kind == FaultKind::kDuplicate) node_->send(f);
+      send_sample(f, k);
+      if (kind == FaultKind::kDuplicate) send_sample(f, k);
     }
   }
 

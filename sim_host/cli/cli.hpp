@@ -16,7 +16,7 @@ namespace vines::cli {
 inline constexpr int kOk = 0;
 inline constexpr int kRefused = 1;       // refused input: bad scene or file, a run that failed
 inline constexpr int kUsage = 2;         // unknown option, bad option value, missing argument
-inline constexpr int kDegraded = 3;      // finished, but a result is degraded (--accept-degraded: 0)
+inline constexpr int kDegraded = 3;      // finished, a result degraded (hil: a fault kind not survived); --accept-degraded: 0
 inline constexpr int kInterrupted = 130; // Ctrl-C
 
 // Adds `vines NAME`: `summary` says what it does (in `vines help` and atop its

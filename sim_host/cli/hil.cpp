@@ -44,9 +44,14 @@ void print_hil(const host::HilReport& r) {
   // Faults, by kind
   std::printf("\n  faults injected %lld, detected %lld, survived %lld; node restarts %lld\n", r.faults_injected,
               r.faults_detected, r.faults_survived, r.node_restarts);
-  for (const auto& [name, c] : r.faults)
-    std::printf("    %-10s injected %5lld  detected %5lld  survived %5lld\n", name.c_str(), c.injected, c.detected,
-                c.survived);
+  // Each kind's verdict: its deviation from the clean run against the bound.
+  for (const auto& [name, c] : r.faults) {
+    std::printf("    %-10s injected %5lld  detected %5lld  %s: deviation %.3g m %s bound %.3g m", name.c_str(),
+                c.injected, c.detected, c.ok ? "survived" : "NOT survived", c.deviation_m,
+                c.deviation_m <= c.bound_m ? "within" : "beyond", c.bound_m);
+    if (c.unanswered) std::printf(", %lld judged samples without telemetry", c.unanswered);
+    std::printf("\n");
+  }
   std::printf("  max deviation from offline %.3g m%s; outputs finite: %s\n", r.max_deviation_from_offline,
               r.bit_exact ? " (bit for bit equal)" : "", r.outputs_finite ? "yes" : "NO");
   // The modes
@@ -72,7 +77,17 @@ int hil(const HilArgs& a) {
   const host::HilReport r = host::run_hil(scene, a.opt);
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
   else print_hil(r);
-  return r.outputs_finite ? kOk : kRefused;
+  if (!r.outputs_finite) return kRefused;
+  // A fault kind not survived: the run finished, its results are degraded.
+  if (!r.survived) {
+    std::string kinds;
+    for (const auto& [name, c] : r.faults)
+      if (!c.ok) kinds += (kinds.empty() ? "" : ", ") + name;
+    std::fflush(stdout);
+    std::fprintf(stderr, "vines hil: not survived: %s (exit %d)\n", kinds.c_str(), kDegraded);
+    return kDegraded;
+  }
+  return kOk;
 }
 
 // What each fault option injects at the samples SPEC picks.
@@ -104,7 +119,12 @@ void add_hil(CLI::App& vines) {
       "reports steps, deadline misses, latency, faults injected/detected/survived and the largest deviation of the "
       "telemetry from the offline run (bit for bit equal without faults); digital-twin monitor and shake-table "
       "(hybrid) modes.",
-      "SPEC of a fault: a rate per sample from 0 to 1, or @K1,K2,... sample indices.", [a] { return hil(*a); });
+      "SPEC of a fault: a rate per sample from 0 to 1 (the probability that a sample is hit; 1: every sample after "
+      "the first; a sample drawn for several kinds takes the first in the order listed), or @K1,K2,... sample "
+      "indices. Each fault kind is reported survived or not: outputs finite and, after each fault's recovery "
+      "window, the top floor's deviation from the clean run within the clean run's peak (docs/link_protocol.md). Exit 0; 3 if a "
+      "kind was not survived; 1 if outputs were not finite or the node failed.",
+      [a] { return hil(*a); });
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
   const std::vector<std::string> modes(std::begin(host::kHilModeNames), std::end(host::kHilModeNames));
   cmd->add_option_function<std::string>(
@@ -193,7 +213,9 @@ void add_hil(CLI::App& vines) {
       ->type_name("P")
       ->check(number_in(0.5, 1000))
       ->group(faults);
-  cmd->add_option("--node-stall", opt.node_stall_periods, "node: stall reported after P periods (default 10)")
+  cmd->add_option("--node-stall", opt.node_stall_periods,
+                  "node: stall reported after P periods (default 10); also each fault's recovery window before "
+                  "survival is judged")
       ->type_name("P")
       ->check(number_in(1, 1e6))
       ->group(faults);
