@@ -19,6 +19,7 @@ struct HilArgs {
   std::string scene_path;
   host::HilOptions opt;
   bool as_json = false;
+  bool accept_degraded = false;
 };
 
 // The hil report as text.
@@ -84,10 +85,9 @@ int hil(const HilArgs& a) {
     for (const auto& [name, c] : r.faults)
       if (!c.ok) kinds += (kinds.empty() ? "" : ", ") + name;
     std::fflush(stdout);
-    std::fprintf(stderr, "vines hil: not survived: %s (exit %d)\n", kinds.c_str(), kDegraded);
-    return kDegraded;
+    std::fprintf(stderr, "vines hil: not survived: %s\n", kinds.c_str());
   }
-  return kOk;
+  return finished_status(!r.survived, a.accept_degraded);
 }
 
 // What each fault option injects at the samples SPEC picks.
@@ -142,6 +142,7 @@ void add_hil(CLI::App& vines) {
       ->type_name("S")
       ->check(number_in(1e-6, 1e6));
   cmd->add_flag("--json", a->as_json, "print one JSON object");
+  add_accept_degraded(*cmd, &a->accept_degraded);
   cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
   cmd->add_option("--timeout", opt.timeout_s, "longest wait for the node (default 5, 60 with QEMU)")
       ->type_name("S")
