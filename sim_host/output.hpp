@@ -30,7 +30,6 @@ class AtomicFile {
   void write(const std::string& s) { write(s.data(), s.size()); }
   // Flushes, syncs and closes the temporary file, then renames it over the target.
   void commit();
-  const std::string& path() const { return path_; }
 
  private:
   [[noreturn]] void fail(int err);  // removes the temporary file and throws
@@ -56,7 +55,6 @@ class OutputDir {
   // holds other files or folders (named). Temporary files an interrupted write
   // left (.NAME.tmp-*) count as the command's.
   OutputDir(std::string dir, std::string command, std::vector<std::string> owned);
-  const std::string& path() const { return dir_; }
   std::string file(const std::string& name) const;  // DIR/NAME
   // After a run: removes the owned files not in `written` (and left temporary files).
   void finish(const std::vector<std::string>& written) const;
