@@ -4,7 +4,7 @@
 Usage: plot_run.py RUN_DIR [RUN_DIR ...] [--out DIR]
 
 Each RUN_DIR holds summary.json and timeseries.csv (a bare, TMD or VI NES run).
-Writes into --out (default: the first RUN_DIR):
+Writes into --out (default: out/plots; not a run folder, which vines run owns):
   fig6_top_displacement.png  top-floor displacement vs time, bare vs each device
   fig7_particle_walls.png    VI NES particle and box walls vs time, contacts marked
   fig8_elastic_energy.png    cumulative elastic energy, normalised by the bare final value
@@ -229,10 +229,10 @@ def fig9(bare, devs, out, written):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
-    ap.add_argument("--out", help="output directory (default: the first RUN_DIR)")
+    ap.add_argument("--out", help="output directory (default: out/plots)")
     args = ap.parse_args(argv)
     runs = [Run(p) for p in args.run_dirs]
-    out = args.out or args.run_dirs[0]
+    out = args.out or "out/plots"
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as e:

@@ -6,7 +6,7 @@ Usage: plot_studies.py SWEEP_DIR [SWEEP_DIR ...] [--out DIR]
 Each SWEEP_DIR holds results.csv (and summary.json) from `vines sweep SPEC.toml --out DIR`.
 The studies of all dirs are pooled and recognised by device and varied keys (columns
 with a dot in their name), preferring the names of data/studies/*.toml. Writes into --out
-(default: the first SWEEP_DIR) whatever the studies allow:
+(default: out/plots; not a sweep folder, which vines sweep owns) whatever the studies allow:
   fig5_clearance.png  x_r, E_r vs beta: VI NES at rest (clearance_vines), IC mean +- sd per
                       beta (ic_vines_vs_beta), TMD at rest line and TMD IC mean +- sd band
   fig10_damage.png    x_r, E_r vs eta_k (damage_vines, damage_tmd)
@@ -345,12 +345,12 @@ def table2(studies, out, written):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("dirs", nargs="+", metavar="SWEEP_DIR")
-    ap.add_argument("--out", help="output directory (default: the first SWEEP_DIR)")
+    ap.add_argument("--out", help="output directory (default: out/plots)")
     a = ap.parse_args(argv)
     studies = {}
     for d in a.dirs:
         load(d, studies)
-    out = a.out or a.dirs[0]
+    out = a.out or "out/plots"
     os.makedirs(out, exist_ok=True)
     written = []
     for fn in (fig5, fig10, ic_heatmap, records_bars, table2):
