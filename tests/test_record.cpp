@@ -334,4 +334,25 @@ TEST_F(RecordFiles, BinaryGarbageIsAnErrorNotACrash) {
   EXPECT_NE(error_of(spec_for(p)).find(p + ":"), std::string::npos);
 }
 
+// parse_record (the fuzzer's entry): the file's text in memory gives the same
+// record, or the same refusal naming spec.path, as load_record on the file.
+TEST_F(RecordFiles, TextInMemoryReadsAsTheFile) {
+  const std::string text = "X\nNPTS= 3, DT= .02 SEC\n 1. -2.5D-1\r\n 3.\n";
+  const RecordSpec file = spec_for(write("m.at2", text));
+  const Record a = load_record(file);
+  const Record b = parse_record(text, file);
+  EXPECT_EQ(a.accel_mps2, b.accel_mps2);
+  EXPECT_EQ(a.dt_s, b.dt_s);
+  EXPECT_EQ(b.path, file.path);
+  for (const std::string bad : {"", "NPTS= 2, DT= .01\n1 x\n"}) {
+    const std::string p = write("bad.at2", bad);
+    try {
+      parse_record(bad, spec_for(p));
+      ADD_FAILURE() << "no RecordError for '" << bad << "'";
+    } catch (const RecordError& e) {
+      EXPECT_EQ(std::string(e.what()), error_of(spec_for(p)));
+    }
+  }
+}
+
 }  // namespace

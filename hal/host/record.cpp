@@ -48,15 +48,8 @@ struct Line {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-std::vector<Line> read_lines(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
-  if (ec) fail(path, "cannot access file: " + ec.message());
-  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file for reading");
-
+// The lines of a stream (a file, or text in memory); `path` names it in messages.
+std::vector<Line> split_lines(std::istream& in, const std::string& path) {
   std::vector<Line> lines;
   std::string text;
   for (std::size_t n = 1; std::getline(in, text); ++n) {
@@ -68,6 +61,17 @@ std::vector<Line> read_lines(const std::string& path) {
       std::all_of(lines.begin(), lines.end(), [](const Line& l) { return l.text.empty(); });
   if (blank) fail(path, "empty file");
   return lines;
+}
+
+std::vector<Line> read_lines(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
+  if (ec) fail(path, "cannot access file: " + ec.message());
+  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file for reading");
+  return split_lines(in, path);
 }
 
 // Splits a line on whitespace; text from a '#' on is dropped when asked (column files).
@@ -268,14 +272,10 @@ double unit_factor(Units u) {
   return 1.0;
 }
 
-}  // namespace
+// ---- from_lines: pick the format, parse, convert to m/s^2 ----
 
-// ---- load_record: pick the format, parse, convert to m/s^2 ----
-
-Record load_record(const RecordSpec& spec) {
+Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
   if (!std::isfinite(spec.scale)) fail(spec.path, "scale must be finite");
-  const std::vector<Line> lines = read_lines(spec.path);
-
   Raw raw;
   const bool maybe_at2 = spec.format == RecordFormat::kAuto || spec.format == RecordFormat::kAt2;
   const auto header = maybe_at2 ? find_at2_header(lines, spec.path) : std::nullopt;
@@ -302,6 +302,19 @@ Record load_record(const RecordSpec& spec) {
   rec.accel_mps2.reserve(raw.values.size());
   for (double v : raw.values) rec.accel_mps2.push_back(v * factor);
   return rec;
+}
+
+}  // namespace
+
+// ---- load_record / parse_record: a file, or its text already in memory ----
+
+Record load_record(const RecordSpec& spec) {
+  return from_lines(read_lines(spec.path), spec);
+}
+
+Record parse_record(const std::string& text, const RecordSpec& spec) {
+  std::istringstream in(text);
+  return from_lines(split_lines(in, spec.path), spec);
 }
 
 double Record::pga_mps2() const {

@@ -52,6 +52,10 @@ class RecordError : public std::runtime_error {
 // non-increasing time column, a bad dt are all RecordErrors.
 Record load_record(const RecordSpec& spec);
 
+// Same checks on the file's text already in memory (the fuzzer, tests):
+// spec.path only names the record in messages.
+Record parse_record(const std::string& text, const RecordSpec& spec);
+
 // Samples the record's piecewise-linear acceleration at t_k = k / rate_hz for
 // k = 0 .. round(duration * rate_hz). The record is taken as zero after its
 // last sample (it ends at t0 + N dt) and before t0.
