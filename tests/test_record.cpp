@@ -355,4 +355,15 @@ TEST_F(RecordFiles, TextInMemoryReadsAsTheFile) {
   }
 }
 
+// A few bytes must not ask for days of samples (found by record_fuzz: NPTS=2
+// with DT=33333 took seconds to resample, a run would simulate 18 hours).
+TEST_F(RecordFiles, RecordEndingAfterAnHourIsRefused) {
+  const std::string late = write("late.txt", "4e5 0\n400000.01 1\n");
+  EXPECT_EQ(error_of(spec_for(late)),
+            late + ": the record ends at t = 400000.02 s, later than the 3600 s a record may last"
+                   " (check DT or the time column)");
+  const std::string hour = write("hour.txt", "3500 1\n3500.5 2\n");  // ends at 3501 s
+  EXPECT_EQ(load_record(spec_for(hour)).accel_mps2.size(), 2u);
+}
+
 }  // namespace

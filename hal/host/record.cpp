@@ -21,6 +21,7 @@ constexpr std::size_t kHeaderSearchLines = 10;    // AT2 NPTS/DT line must be wi
 constexpr double kTimeTolerance = 1e-3;           // allowed time-column jitter, relative to dt
 constexpr double kKnotSnap = 1e-9;                // a knot if |u - round(u)| is below (u in dt)
 constexpr long long kMaxResampled = 100'000'000;  // refuse absurd resampling requests
+constexpr double kMaxRecordEndS = 3600.0;         // a record ends within the hour (real ones: minutes)
 
 // ---- errors: "path:line: what" or "path: what" ----
 
@@ -292,6 +293,13 @@ Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
     raw = (spec.format == RecordFormat::kAuto && table.columns == 1)
               ? parse_accel(lines, spec)
               : parse_time_accel(table, spec);
+  }
+  // A few bytes must not ask for days of samples (found by record_fuzz: a
+  // huge DT or a time column that starts late; the run would simulate it all).
+  const double end_s = raw.t0 + raw.dt * static_cast<double>(raw.values.size());
+  if (!(end_s <= kMaxRecordEndS)) {
+    fail(spec.path, "the record ends at t = " + fmt(end_s) + " s, later than the " +
+                        fmt(kMaxRecordEndS) + " s a record may last (check DT or the time column)");
   }
 
   Record rec;
