@@ -16,7 +16,7 @@ cmake --build --preset release -j2
 ctest --preset release
 
 # The host under AddressSanitizer and UBSan (preset debug): the subset labelled
-# "sanitize" (tests/README.md: which tests, why a subset, its time); any
+# unit_sanitize (tests/README.md: which tests, why a subset, its time); any
 # sanitizer report stops the test and fails it (halt_on_error in the preset).
 cmake --preset debug
 cmake --build --preset debug -j2 --target sanitize_tests
