@@ -334,4 +334,36 @@ TEST_F(RecordFiles, BinaryGarbageIsAnErrorNotACrash) {
   EXPECT_NE(error_of(spec_for(p)).find(p + ":"), std::string::npos);
 }
 
+// parse_record (the fuzzer's entry): the file's text in memory gives the same
+// record, or the same refusal naming spec.path, as load_record on the file.
+TEST_F(RecordFiles, TextInMemoryReadsAsTheFile) {
+  const std::string text = "X\nNPTS= 3, DT= .02 SEC\n 1. -2.5D-1\r\n 3.\n";
+  const RecordSpec file = spec_for(write("m.at2", text));
+  const Record a = load_record(file);
+  const Record b = parse_record(text, file);
+  EXPECT_EQ(a.accel_mps2, b.accel_mps2);
+  EXPECT_EQ(a.dt_s, b.dt_s);
+  EXPECT_EQ(b.path, file.path);
+  for (const std::string bad : {"", "NPTS= 2, DT= .01\n1 x\n"}) {
+    const std::string p = write("bad.at2", bad);
+    try {
+      parse_record(bad, spec_for(p));
+      ADD_FAILURE() << "no RecordError for '" << bad << "'";
+    } catch (const RecordError& e) {
+      EXPECT_EQ(std::string(e.what()), error_of(spec_for(p)));
+    }
+  }
+}
+
+// A few bytes must not ask for days of samples (found by record_fuzz: NPTS=2
+// with DT=33333 took seconds to resample, a run would simulate 18 hours).
+TEST_F(RecordFiles, RecordEndingAfterAnHourIsRefused) {
+  const std::string late = write("late.txt", "4e5 0\n400000.01 1\n");
+  EXPECT_EQ(error_of(spec_for(late)),
+            late + ": the record ends at t = 400000.02 s, later than the 3600 s a record may last"
+                   " (check DT or the time column)");
+  const std::string hour = write("hour.txt", "3500 1\n3500.5 2\n");  // ends at 3501 s
+  EXPECT_EQ(load_record(spec_for(hour)).accel_mps2.size(), 2u);
+}
+
 }  // namespace

@@ -157,6 +157,13 @@ TEST(SceneError, SyntaxErrorHasLine) {
   EXPECT_NE(msg.find("bad.toml:3:"), std::string::npos) << msg;
   EXPECT_NE(msg.find("syntax"), std::string::npos) << msg;
   expect_refused(kBase + "[device]\nkind = \"tmd\"\n", {"bad.toml:6:", "device"});  // defined twice
+  // Found by scene_fuzz on toml++ 3.3.0 compiled with assertions and UBSan
+  // (tests/fuzz/README.md): a control character where a key starts, a
+  // non-ASCII character where whitespace may stand. The library the program
+  // links refuses both.
+  expect_refused("[\x01loop]\n" + kBase, {"bad.toml:1:2:", "syntax", "bare key"});
+  expect_refused("[record]\npath = \"a\" \xc2\xa1\n", {"bad.toml:2:12:", "syntax"});
+  expect_refused("\xef\xb7\xbf[record]\npath = \"a\"\n", {"bad.toml:1:1:", "syntax"});
 }
 
 TEST(SceneError, MissingFile) {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The project's test command. Host: build and run the unit tests (preset
-# release). MCU: for each target (presets cortex-m4f and cortex-m7), build the
+# release), then a subset of them under the sanitizers (presets debug and
+# sanitize). MCU: for each target (presets cortex-m4f and cortex-m7), build the
 # images (the build also proves that the link refuses the heap) and run the
 # MCU tests in QEMU (ctest --preset <target>): the smoke image, the
 # stack-overflow fault, the El Centro VI NES and TMD scenes fed over the UART
@@ -13,6 +14,13 @@ bash tools/setup.sh
 cmake --preset release
 cmake --build --preset release -j2
 ctest --preset release
+
+# The host under AddressSanitizer and UBSan (preset debug): the subset labelled
+# unit_sanitize (tests/README.md: which tests, why a subset, its time); any
+# sanitizer report stops the test and fails it (halt_on_error in the preset).
+cmake --preset debug
+cmake --build --preset debug -j2 --target sanitize_tests
+ctest --preset sanitize
 
 for target in cortex-m4f cortex-m7; do
   cmake --preset "$target"

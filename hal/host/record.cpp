@@ -21,6 +21,7 @@ constexpr std::size_t kHeaderSearchLines = 10;    // AT2 NPTS/DT line must be wi
 constexpr double kTimeTolerance = 1e-3;           // allowed time-column jitter, relative to dt
 constexpr double kKnotSnap = 1e-9;                // a knot if |u - round(u)| is below (u in dt)
 constexpr long long kMaxResampled = 100'000'000;  // refuse absurd resampling requests
+constexpr double kMaxRecordEndS = 3600.0;         // a record ends within the hour (real ones: minutes)
 
 // ---- errors: "path:line: what" or "path: what" ----
 
@@ -48,15 +49,8 @@ struct Line {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-std::vector<Line> read_lines(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
-  if (ec) fail(path, "cannot access file: " + ec.message());
-  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file for reading");
-
+// The lines of a stream (a file, or text in memory); `path` names it in messages.
+std::vector<Line> split_lines(std::istream& in, const std::string& path) {
   std::vector<Line> lines;
   std::string text;
   for (std::size_t n = 1; std::getline(in, text); ++n) {
@@ -68,6 +62,17 @@ std::vector<Line> read_lines(const std::string& path) {
       std::all_of(lines.begin(), lines.end(), [](const Line& l) { return l.text.empty(); });
   if (blank) fail(path, "empty file");
   return lines;
+}
+
+std::vector<Line> read_lines(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
+  if (ec) fail(path, "cannot access file: " + ec.message());
+  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file for reading");
+  return split_lines(in, path);
 }
 
 // Splits a line on whitespace; text from a '#' on is dropped when asked (column files).
@@ -268,14 +273,10 @@ double unit_factor(Units u) {
   return 1.0;
 }
 
-}  // namespace
+// ---- from_lines: pick the format, parse, convert to m/s^2 ----
 
-// ---- load_record: pick the format, parse, convert to m/s^2 ----
-
-Record load_record(const RecordSpec& spec) {
+Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
   if (!std::isfinite(spec.scale)) fail(spec.path, "scale must be finite");
-  const std::vector<Line> lines = read_lines(spec.path);
-
   Raw raw;
   const bool maybe_at2 = spec.format == RecordFormat::kAuto || spec.format == RecordFormat::kAt2;
   const auto header = maybe_at2 ? find_at2_header(lines, spec.path) : std::nullopt;
@@ -293,6 +294,13 @@ Record load_record(const RecordSpec& spec) {
               ? parse_accel(lines, spec)
               : parse_time_accel(table, spec);
   }
+  // A few bytes must not ask for days of samples (found by record_fuzz: a
+  // huge DT or a time column that starts late; the run would simulate it all).
+  const double end_s = raw.t0 + raw.dt * static_cast<double>(raw.values.size());
+  if (!(end_s <= kMaxRecordEndS)) {
+    fail(spec.path, "the record ends at t = " + fmt(end_s) + " s, later than the " +
+                        fmt(kMaxRecordEndS) + " s a record may last (check DT or the time column)");
+  }
 
   Record rec;
   rec.path = spec.path;
@@ -302,6 +310,19 @@ Record load_record(const RecordSpec& spec) {
   rec.accel_mps2.reserve(raw.values.size());
   for (double v : raw.values) rec.accel_mps2.push_back(v * factor);
   return rec;
+}
+
+}  // namespace
+
+// ---- load_record / parse_record: a file, or its text already in memory ----
+
+Record load_record(const RecordSpec& spec) {
+  return from_lines(read_lines(spec.path), spec);
+}
+
+Record parse_record(const std::string& text, const RecordSpec& spec) {
+  std::istringstream in(text);
+  return from_lines(split_lines(in, spec.path), spec);
 }
 
 double Record::pga_mps2() const {

@@ -49,8 +49,13 @@ class RecordError : public std::runtime_error {
 
 // Reads and checks a record: missing or empty file, non-numeric or non-finite
 // values, NPTS that disagrees with the values read, a non-uniform or
-// non-increasing time column, a bad dt are all RecordErrors.
+// non-increasing time column, a bad dt, a record ending after 3600 s are all
+// RecordErrors.
 Record load_record(const RecordSpec& spec);
+
+// Same checks on the file's text already in memory (the fuzzer, tests):
+// spec.path only names the record in messages.
+Record parse_record(const std::string& text, const RecordSpec& spec);
 
 // Samples the record's piecewise-linear acceleration at t_k = k / rate_hz for
 // k = 0 .. round(duration * rate_hz). The record is taken as zero after its
