@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -49,21 +51,24 @@ struct Line {
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 std::vector<Line> read_lines(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
-  if (ec) fail(path, "cannot access file: " + ec.message());
-  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file for reading");
-
+  std::string content;
+  try {
+    content = read_input_file(path, kMaxRecordBytes);
+  } catch (const std::runtime_error& e) {
+    throw RecordError(e.what());
+  }
+  const auto newlines = static_cast<std::size_t>(std::count(content.begin(), content.end(), '\n'));
+  if (newlines > kMaxRecordPoints) {
+    fail(path, std::to_string(newlines) + " lines: more than the " + std::to_string(kMaxRecordPoints) +
+                   " a record may have");
+  }
   std::vector<Line> lines;
+  std::istringstream in(content);
   std::string text;
   for (std::size_t n = 1; std::getline(in, text); ++n) {
     while (!text.empty() && is_space(text.back())) text.pop_back();
     lines.push_back({n, std::move(text)});
   }
-  if (in.bad()) fail(path, "read error");
   const bool blank =
       std::all_of(lines.begin(), lines.end(), [](const Line& l) { return l.text.empty(); });
   if (blank) fail(path, "empty file");
@@ -136,6 +141,10 @@ std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const s
     const std::string npts = npts_m[1].str();
     const auto r = std::from_chars(npts.data(), npts.data() + npts.size(), h.npts);
     if (r.ec != std::errc() || h.npts == 0) fail(path, lines[i].number, "bad NPTS '" + npts + "'");
+    if (h.npts > kMaxRecordPoints) {
+      fail(path, lines[i].number,
+           "NPTS=" + npts + ": more than the " + std::to_string(kMaxRecordPoints) + " points a record may have");
+    }
     h.dt = parse_number(dt_m[1].str(), path, lines[i].number);
     if (!(h.dt > 0.0)) fail(path, lines[i].number, "DT must be positive, got " + dt_m[1].str());
 
@@ -268,7 +277,52 @@ double unit_factor(Units u) {
   return 1.0;
 }
 
+// A record's dt must be in [kMinRecordDt, kMaxRecordDt] and its point count bounded.
+void check_dt(const std::string& path, double dt) {
+  if (!(std::isfinite(dt) && dt >= kMinRecordDt && dt <= kMaxRecordDt)) {
+    fail(path, "dt " + fmt(dt) + " s is outside [" + fmt(kMinRecordDt) + ", " + fmt(kMaxRecordDt) +
+                   "] s");
+  }
+}
+
+void check_points(const std::string& path, std::size_t n) {
+  if (n > kMaxRecordPoints) {
+    fail(path, std::to_string(n) + " points: more than the " + std::to_string(kMaxRecordPoints) +
+                   " a record may have");
+  }
+}
+
 }  // namespace
+
+// ---- input files: regular, bounded, read whole ----
+
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  auto refuse = [&](const std::string& why) { throw std::runtime_error(path + ": " + why); };
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) refuse("file not found");
+  if (ec) refuse("cannot access file: " + ec.message());
+  if (st.type() == fs::file_type::directory) refuse("is a directory, not a file");
+  if (st.type() != fs::file_type::regular) {
+    refuse("not a regular file (a device, FIFO or socket): only files on disk are read");
+  }
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) refuse("cannot access file: " + ec.message());
+  if (size > max_bytes) {
+    refuse("file of " + std::to_string(size) + " bytes: larger than the " + std::to_string(max_bytes) +
+           " bytes an input may have");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) refuse(std::string("cannot open file for reading: ") + std::strerror(errno));
+  // One byte more than measured: reading it means the file grew while read.
+  std::string content(static_cast<std::size_t>(size) + 1, '\0');
+  in.read(content.data(), static_cast<std::streamsize>(content.size()));
+  if (in.bad()) refuse("read error");
+  content.resize(static_cast<std::size_t>(in.gcount()));
+  if (content.size() > size) refuse("changed while it was read");
+  return content;
+}
 
 // ---- load_record: pick the format, parse, convert to m/s^2 ----
 
@@ -294,6 +348,9 @@ Record load_record(const RecordSpec& spec) {
               : parse_time_accel(table, spec);
   }
 
+  check_points(spec.path, raw.values.size());
+  check_dt(spec.path, raw.dt);
+
   Record rec;
   rec.path = spec.path;
   rec.dt_s = raw.dt;
@@ -302,6 +359,18 @@ Record load_record(const RecordSpec& spec) {
   rec.accel_mps2.reserve(raw.values.size());
   for (double v : raw.values) rec.accel_mps2.push_back(v * factor);
   return rec;
+}
+
+// ---- detection: what kAuto reads the file as ----
+
+RecordFormat detect_record_format(const std::string& path) {
+  const std::vector<Line> lines = read_lines(path);
+  if (find_at2_header(lines, path)) return RecordFormat::kAt2;
+  for (const Line& l : lines) {
+    const auto toks = tokens(l.text, true);
+    if (!toks.empty()) return toks.size() == 1 ? RecordFormat::kAccel : RecordFormat::kTimeAccel;
+  }
+  fail(path, "no samples");
 }
 
 double Record::pga_mps2() const {
