@@ -60,6 +60,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim_host/scene_limits.hpp"
 #include "sim_host/scene_section.hpp"
 #include "sim_host/scene_toml.hpp"
 #include "vines/contact_laws.hpp"
@@ -315,6 +316,11 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
     if (e.index >= 0) key += "[" + std::to_string(e.index) + "]";
     const toml::node* n = root.at_path(key).node();
     fail(origin, n != nullptr ? &n->source() : nullptr, key, e.message);
+  }
+  // Contact scales no run could resolve, or overlaps past the sphere (scene_limits.hpp).
+  if (const auto e = check_contact_scales(p)) {
+    const toml::node* n = root.at_path(e->key).node();
+    fail(origin, n != nullptr ? &n->source() : nullptr, e->key, e->message);
   }
   read_output(Section(origin, root, "output", {"rate_hz", "timeseries"}), p.loop.sensor_rate_hz,
               &scene.output);
