@@ -44,7 +44,7 @@ TEST_F(RecordFiles, TooManyPointsAreRefused) {
   const std::string lines = write("lines.txt", std::string(kMaxRecordPoints + 1, '\n'));
   EXPECT_NE(error_of(spec_for(lines)).find("2000001 lines: more than the 2000000"), std::string::npos);
   const std::string npts = write("npts.at2", "PEER\nx\nx\nNPTS= 9000000, DT= .01 SEC\n0.1\n");
-  EXPECT_EQ(error_of(spec_for(npts)), npts + ":4: NPTS=9000000: more than the 2000000 points a record may have");
+  EXPECT_EQ(error_of(spec_for(npts)), npts + ":4: 9000000 points (NPTS): more than the 2000000 a record may have");
   std::string row;
   for (int i = 0; i < 8; ++i) row += "0 ";
   std::string body;

@@ -4,10 +4,8 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -41,6 +39,14 @@ std::string fmt(double v) {
   return os.str();
 }
 
+// Lines, points: at most kMaxRecordPoints of them.
+void check_count(const std::string& where, std::size_t n, const std::string& what) {
+  if (n > kMaxRecordPoints) {
+    fail(where, std::to_string(n) + " " + what + ": more than the " + std::to_string(kMaxRecordPoints) +
+                    " a record may have");
+  }
+}
+
 // ---- reading: the file as lines, trailing whitespace and CR removed ----
 
 struct Line {
@@ -57,11 +63,7 @@ std::vector<Line> read_lines(const std::string& path) {
   } catch (const std::runtime_error& e) {
     throw RecordError(e.what());
   }
-  const auto newlines = static_cast<std::size_t>(std::count(content.begin(), content.end(), '\n'));
-  if (newlines > kMaxRecordPoints) {
-    fail(path, std::to_string(newlines) + " lines: more than the " + std::to_string(kMaxRecordPoints) +
-                   " a record may have");
-  }
+  check_count(path, static_cast<std::size_t>(std::count(content.begin(), content.end(), '\n')), "lines");
   std::vector<Line> lines;
   std::istringstream in(content);
   std::string text;
@@ -141,10 +143,7 @@ std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const s
     const std::string npts = npts_m[1].str();
     const auto r = std::from_chars(npts.data(), npts.data() + npts.size(), h.npts);
     if (r.ec != std::errc() || h.npts == 0) fail(path, lines[i].number, "bad NPTS '" + npts + "'");
-    if (h.npts > kMaxRecordPoints) {
-      fail(path, lines[i].number,
-           "NPTS=" + npts + ": more than the " + std::to_string(kMaxRecordPoints) + " points a record may have");
-    }
+    check_count(path + ":" + std::to_string(lines[i].number), h.npts, "points (NPTS)");
     h.dt = parse_number(dt_m[1].str(), path, lines[i].number);
     if (!(h.dt > 0.0)) fail(path, lines[i].number, "DT must be positive, got " + dt_m[1].str());
 
@@ -277,7 +276,7 @@ double unit_factor(Units u) {
   return 1.0;
 }
 
-// A record's dt must be in [kMinRecordDt, kMaxRecordDt] and its point count bounded.
+// A record's dt must be in [kMinRecordDt, kMaxRecordDt].
 void check_dt(const std::string& path, double dt) {
   if (!(std::isfinite(dt) && dt >= kMinRecordDt && dt <= kMaxRecordDt)) {
     fail(path, "dt " + fmt(dt) + " s is outside [" + fmt(kMinRecordDt) + ", " + fmt(kMaxRecordDt) +
@@ -285,44 +284,7 @@ void check_dt(const std::string& path, double dt) {
   }
 }
 
-void check_points(const std::string& path, std::size_t n) {
-  if (n > kMaxRecordPoints) {
-    fail(path, std::to_string(n) + " points: more than the " + std::to_string(kMaxRecordPoints) +
-                   " a record may have");
-  }
-}
-
 }  // namespace
-
-// ---- input files: regular, bounded, read whole ----
-
-std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
-  namespace fs = std::filesystem;
-  auto refuse = [&](const std::string& why) { throw std::runtime_error(path + ": " + why); };
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (st.type() == fs::file_type::not_found) refuse("file not found");
-  if (ec) refuse("cannot access file: " + ec.message());
-  if (st.type() == fs::file_type::directory) refuse("is a directory, not a file");
-  if (st.type() != fs::file_type::regular) {
-    refuse("not a regular file (a device, FIFO or socket): only files on disk are read");
-  }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) refuse("cannot access file: " + ec.message());
-  if (size > max_bytes) {
-    refuse("file of " + std::to_string(size) + " bytes: larger than the " + std::to_string(max_bytes) +
-           " bytes an input may have");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) refuse(std::string("cannot open file for reading: ") + std::strerror(errno));
-  // One byte more than measured: reading it means the file grew while read.
-  std::string content(static_cast<std::size_t>(size) + 1, '\0');
-  in.read(content.data(), static_cast<std::streamsize>(content.size()));
-  if (in.bad()) refuse("read error");
-  content.resize(static_cast<std::size_t>(in.gcount()));
-  if (content.size() > size) refuse("changed while it was read");
-  return content;
-}
 
 // ---- load_record: pick the format, parse, convert to m/s^2 ----
 
@@ -348,7 +310,7 @@ Record load_record(const RecordSpec& spec) {
               : parse_time_accel(table, spec);
   }
 
-  check_points(spec.path, raw.values.size());
+  check_count(spec.path, raw.values.size(), "points");
   check_dt(spec.path, raw.dt);
 
   Record rec;
