@@ -122,16 +122,24 @@ void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev
 
 }  // namespace
 
-Excitation load_excitation(const Scene& scene, const std::string& record_override) {
+Excitation load_excitation(const Scene& scene, const std::string& record_override,
+                           const RecordReading& reading) {
   hal::RecordSpec spec = scene.record;
   if (!record_override.empty()) {
-    if (!fs::is_regular_file(record_override))
-      throw std::runtime_error("--record " + record_override + ": no such file");
+    // The file's own format (detected unless forced), units, column and dt;
+    // the scene's scale / pga_g and duration_s still apply.
     spec.path = record_override;
-    // The file says its own format (a PEER AT2 header, else columns), not
-    // the scene's record; the scene's units, column and scale still apply to
-    // columns, and a values-only record keeps the scene's dt.
-    if (spec.format != hal::RecordFormat::kAccel) spec.format = hal::RecordFormat::kAuto;
+    spec.format = reading.format;
+    spec.units = reading.units;
+    spec.column = reading.column;
+    spec.dt_s = reading.dt_s;
+    const bool values_only = spec.format == hal::RecordFormat::kAccel ||
+                             (spec.format == hal::RecordFormat::kAuto &&
+                              hal::detect_record_format(spec.path) == hal::RecordFormat::kAccel);
+    if (values_only && !(spec.dt_s > 0.0))
+      throw hal::RecordError("--record " + spec.path +
+                             ": one column of values and no time: give its sample step with --record-dt "
+                             "SECONDS (or --record-format for another format)");
   } else {
     spec.path = resolve_record_path(spec.path, scene.path);
   }
@@ -154,7 +162,7 @@ Excitation load_excitation(const Scene& scene, const std::string& record_overrid
 }
 
 RunReport run_scene(const Scene& scene, const RunOptions& opt) {
-  const Excitation ex = load_excitation(scene, opt.record_override);
+  const Excitation ex = load_excitation(scene, opt.record_override, opt.record_reading);
   const SceneParams& p = scene.params;
   const bool has_device = p.device.kind != DeviceKind::kNone;
   const bool series = !opt.out_dir.empty() && scene.output.timeseries;

@@ -15,8 +15,19 @@
 
 namespace vines::host {
 
+// How to read a --record file. The scene's [record] describes the scene's own
+// file: for another file only its intensity and window (scale or pga_g,
+// duration_s) still apply; the format, units, column and dt are the file's.
+struct RecordReading {
+  hal::RecordFormat format = hal::RecordFormat::kAuto;  // --record-format (auto: from the file)
+  hal::Units units = hal::Units::kG;  // --record-units (an AT2 file's header wins)
+  int column = 1;                     // --record-column: time-accel, 1 = first after time
+  double dt_s = 0.0;                  // --record-dt: a single column of values
+};
+
 struct RunOptions {
   std::string record_override;  // --record PATH
+  RecordReading record_reading;  // how to read it
   std::string out_dir;          // --out DIR ("" = write nothing)
   bool quiet = false;
 };
@@ -32,7 +43,9 @@ struct Excitation {
 // displacements, E_r from the elastic energy integrals (docs/model.md).
 inline double reduction(double bare, double with_device) { return (bare - with_device) / bare; }
 
-Excitation load_excitation(const Scene& scene, const std::string& record_override);
+// The scene's record, or record_override ("" = none) read as `reading` says.
+Excitation load_excitation(const Scene& scene, const std::string& record_override,
+                           const RecordReading& reading = {});
 
 // The record a run read, as loaded and scaled.
 struct RecordSummary {

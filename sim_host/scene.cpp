@@ -60,6 +60,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim_host/scene_limits.hpp"
 #include "sim_host/scene_section.hpp"
 #include "sim_host/scene_toml.hpp"
 #include "vines/contact_laws.hpp"
@@ -316,6 +317,11 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
     const toml::node* n = root.at_path(key).node();
     fail(origin, n != nullptr ? &n->source() : nullptr, key, e.message);
   }
+  // Contact scales no run could resolve, or overlaps past the sphere (scene_limits.hpp).
+  if (const auto e = check_contact_scales(p)) {
+    const toml::node* n = root.at_path(e->key).node();
+    fail(origin, n != nullptr ? &n->source() : nullptr, e->key, e->message);
+  }
   read_output(Section(origin, root, "output", {"rate_hz", "timeseries"}), p.loop.sensor_rate_hz,
               &scene.output);
   return scene;
@@ -323,11 +329,13 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
 
 // ---- load: file -> table -> Scene ----
 toml::table read_scene_table(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ": cannot open the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene_table(text.str(), path);
+  std::string text;
+  try {
+    text = hal::read_input_file(path, kMaxSceneBytes);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(std::string(e.what()) + " (a scene file)");
+  }
+  return parse_scene_table(text, path);
 }
 
 Scene load_scene(const std::string& path) { return scene_from_table(read_scene_table(path), path); }
@@ -355,8 +363,12 @@ std::string resolve_record_path(const std::string& record_path, const std::strin
   std::string list;
   for (const auto& [candidate, why] : tried) {
     std::error_code ec;
-    if (fs::is_regular_file(candidate, ec))
-      return fs::absolute(candidate).lexically_normal().string();
+    const fs::file_type type = fs::status(candidate, ec).type();
+    if (type == fs::file_type::regular) return fs::absolute(candidate).lexically_normal().string();
+    // A folder, a device or a FIFO by that name: refused, not searched past.
+    if (type != fs::file_type::not_found && type != fs::file_type::none)
+      throw SceneError(scene_path + ": record.path: \"" + record_path + "\": " + candidate.string() + " (" + why +
+                       ") is not a regular file (a folder, device or FIFO)");
     list += (list.empty() ? "" : ", ") + candidate.string() + " (" + why + ")";
   }
   throw SceneError(scene_path + ": record.path: \"" + record_path + "\" not found; tried " + list);

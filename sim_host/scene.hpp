@@ -4,6 +4,7 @@
 // names the file and the key ("scene.toml: vines.beta: must be > 1 ...").
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -31,13 +32,17 @@ struct Scene {
   OutputSpec output;
 };
 
+// Scene files and study specs are at most 1 MiB: the largest shipped is 3 kB,
+// and a custom frame of 40 stories with every key written fits in 10 kB.
+inline constexpr std::uintmax_t kMaxSceneBytes = 1u << 20;
+
 class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
-// Parses and validates a scene file (unknown keys, wrong types, bad values are
-// SceneErrors). The record path is left as written; see resolve_record_path.
+// Parses and validates a scene file (not a regular file, over kMaxSceneBytes,
+// unknown keys, wrong types, bad values are SceneErrors). The record path is left as written; see resolve_record_path.
 Scene load_scene(const std::string& path);
 
 // Same, from TOML text (for tests); `origin` names it in messages.

@@ -10,6 +10,7 @@
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/parallel.hpp"
+#include "sim_host/scene_limits.hpp"
 #include "sim_host/status.hpp"
 
 namespace vines::host {
@@ -224,6 +225,11 @@ StressResult run_case(const StressCase& c, const std::vector<StressRecord>& reco
   StressResult r;
   r.done = true;
   const std::vector<double> a = case_samples(c, records);
+  // Refused as a scene file would be: contact scales no run can resolve.
+  if (const auto e = check_contact_scales(c.params)) {
+    r.refusal = e->key + ": " + e->rule;
+    return r;
+  }
   std::unique_ptr<Engine> eng = build(c.params, c.scalar, &r.refusal);
   if (!eng) return r;
   const ModelInfo info = eng->info();

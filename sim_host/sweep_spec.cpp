@@ -170,8 +170,14 @@ std::string KeyValue::label() const {
 // ---- spec file ----
 SweepSpec load_sweep(const std::string& path) {
   toml::table root;
+  std::string text;
   try {
-    root = toml::parse_file(path);
+    text = hal::read_input_file(path, kMaxSceneBytes);  // a regular file of bounded size
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(e.what()) + " (a study spec)");
+  }
+  try {
+    root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     fail(path + ":" + std::to_string(e.source().begin.line), "TOML syntax error: " + std::string(e.description()));
   }

@@ -23,40 +23,6 @@ constexpr double kG = 9.80665;
 
 // ---- helpers ----
 
-// A fresh directory per test for hand-written record files.
-class RecordFiles : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("vines_record_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  // Writes bytes exactly as given (CRLF stays CRLF) and returns the path.
-  std::string write(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p.string();
-  }
-
-  fs::path dir_;
-};
-
-// The RecordError message load_record throws for spec ("" and a test failure if none).
-std::string error_of(const RecordSpec& spec) {
-  try {
-    load_record(spec);
-  } catch (const RecordError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no RecordError for " << spec.path;
-  return "";
-}
-
-
 // Index of the sample with the largest |a| (the first one on ties).
 std::size_t peak_index(const Record& r) {
   std::size_t best = 0;

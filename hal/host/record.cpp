@@ -40,6 +40,14 @@ std::string fmt(double v) {
   return os.str();
 }
 
+// Lines, points: at most kMaxRecordPoints of them.
+void check_count(const std::string& where, std::size_t n, const std::string& what) {
+  if (n > kMaxRecordPoints) {
+    fail(where, std::to_string(n) + " " + what + ": more than the " + std::to_string(kMaxRecordPoints) +
+                    " a record may have");
+  }
+}
+
 // ---- reading: the file as lines, trailing whitespace and CR removed ----
 
 struct Line {
@@ -49,30 +57,32 @@ struct Line {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
-// The lines of a stream (a file, or text in memory); `path` names it in messages.
-std::vector<Line> split_lines(std::istream& in, const std::string& path) {
+// The lines of a record's text (a file's content, or text in memory); `path`
+// names it in messages.
+std::vector<Line> split_lines(const std::string& content, const std::string& path) {
+  check_count(path, static_cast<std::size_t>(std::count(content.begin(), content.end(), '\n')), "lines");
   std::vector<Line> lines;
+  std::istringstream in(content);
   std::string text;
   for (std::size_t n = 1; std::getline(in, text); ++n) {
     while (!text.empty() && is_space(text.back())) text.pop_back();
     lines.push_back({n, std::move(text)});
   }
-  if (in.bad()) fail(path, "read error");
   const bool blank =
       std::all_of(lines.begin(), lines.end(), [](const Line& l) { return l.text.empty(); });
   if (blank) fail(path, "empty file");
   return lines;
 }
 
+// The lines of a record file (a regular file of at most kMaxRecordBytes).
 std::vector<Line> read_lines(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (status.type() == std::filesystem::file_type::not_found) fail(path, "file not found");
-  if (ec) fail(path, "cannot access file: " + ec.message());
-  if (std::filesystem::is_directory(status)) fail(path, "is a directory, not a record file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file for reading");
-  return split_lines(in, path);
+  std::string content;
+  try {
+    content = read_input_file(path, kMaxRecordBytes);
+  } catch (const std::runtime_error& e) {
+    throw RecordError(e.what());
+  }
+  return split_lines(content, path);
 }
 
 // Splits a line on whitespace; text from a '#' on is dropped when asked (column files).
@@ -141,6 +151,7 @@ std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const s
     const std::string npts = npts_m[1].str();
     const auto r = std::from_chars(npts.data(), npts.data() + npts.size(), h.npts);
     if (r.ec != std::errc() || h.npts == 0) fail(path, lines[i].number, "bad NPTS '" + npts + "'");
+    check_count(path + ":" + std::to_string(lines[i].number), h.npts, "points (NPTS)");
     h.dt = parse_number(dt_m[1].str(), path, lines[i].number);
     if (!(h.dt > 0.0)) fail(path, lines[i].number, "DT must be positive, got " + dt_m[1].str());
 
@@ -273,6 +284,14 @@ double unit_factor(Units u) {
   return 1.0;
 }
 
+// A record's dt must be in [kMinRecordDt, kMaxRecordDt].
+void check_dt(const std::string& path, double dt) {
+  if (!(std::isfinite(dt) && dt >= kMinRecordDt && dt <= kMaxRecordDt)) {
+    fail(path, "dt " + fmt(dt) + " s is outside [" + fmt(kMinRecordDt) + ", " + fmt(kMaxRecordDt) +
+                   "] s");
+  }
+}
+
 // ---- from_lines: pick the format, parse, convert to m/s^2 ----
 
 Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
@@ -294,6 +313,8 @@ Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
               ? parse_accel(lines, spec)
               : parse_time_accel(table, spec);
   }
+  check_count(spec.path, raw.values.size(), "points");
+  check_dt(spec.path, raw.dt);
   // A few bytes must not ask for days of samples (found by record_fuzz: a
   // huge DT or a time column that starts late; the run would simulate it all).
   const double end_s = raw.t0 + raw.dt * static_cast<double>(raw.values.size());
@@ -321,8 +342,19 @@ Record load_record(const RecordSpec& spec) {
 }
 
 Record parse_record(const std::string& text, const RecordSpec& spec) {
-  std::istringstream in(text);
-  return from_lines(split_lines(in, spec.path), spec);
+  return from_lines(split_lines(text, spec.path), spec);
+}
+
+// ---- detection: what kAuto reads the file as ----
+
+RecordFormat detect_record_format(const std::string& path) {
+  const std::vector<Line> lines = read_lines(path);
+  if (find_at2_header(lines, path)) return RecordFormat::kAt2;
+  for (const Line& l : lines) {
+    const auto toks = tokens(l.text, true);
+    if (!toks.empty()) return toks.size() == 1 ? RecordFormat::kAccel : RecordFormat::kTimeAccel;
+  }
+  fail(path, "no samples");
 }
 
 double Record::pga_mps2() const {

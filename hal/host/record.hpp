@@ -47,15 +47,34 @@ class RecordError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Reads and checks a record: missing or empty file, non-numeric or non-finite
-// values, NPTS that disagrees with the values read, a non-uniform or
-// non-increasing time column, a bad dt, a record ending after 3600 s are all
+// Limits of an input file (docs in hal/README.md): the largest real record of
+// ../shared/data/ground_motions is 0.4 MB and 8,171 points, so these are far
+// beyond any real record (80x, 250x) and keep a runaway file's memory bounded.
+inline constexpr std::uintmax_t kMaxRecordBytes = 32u << 20;  // 32 MiB
+inline constexpr std::size_t kMaxRecordPoints = 2'000'000;    // lines and values
+inline constexpr double kMinRecordDt = 1e-6;  // s: a 1 MHz record
+inline constexpr double kMaxRecordDt = 1.0;   // s: slower cannot describe ground shaking
+
+// The whole content of `path`, which must be a regular file (not a folder, a
+// device such as /dev/zero, a FIFO or a terminal) of at most max_bytes.
+// std::runtime_error "path: why" otherwise (the system's reason included).
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
+
+// Reads and checks a record: missing, empty, not regular or oversize file,
+// non-numeric or non-finite values, too many points, NPTS that disagrees with
+// the values read, a non-uniform or non-increasing time column, a dt outside
+// [kMinRecordDt, kMaxRecordDt], a record ending after 3600 s are all
 // RecordErrors.
 Record load_record(const RecordSpec& spec);
 
 // Same checks on the file's text already in memory (the fuzzer, tests):
 // spec.path only names the record in messages.
 Record parse_record(const std::string& text, const RecordSpec& spec);
+
+// The format of a record file as kAuto would read it: kAt2 if an NPTS/DT
+// header line is in its first lines, else kTimeAccel for two or more columns,
+// kAccel for one. RecordError if the file cannot be read.
+RecordFormat detect_record_format(const std::string& path);
 
 // Samples the record's piecewise-linear acceleration at t_k = k / rate_hz for
 // k = 0 .. round(duration * rate_hz). The record is taken as zero after its

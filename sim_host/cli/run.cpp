@@ -1,7 +1,9 @@
 // `vines run SCENE.toml`: one scene (and its bare frame), summary.json and timeseries.csv.
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/names.hpp"
@@ -12,8 +14,24 @@
 namespace vines::cli {
 namespace {
 
+// --record-format and --record-units: the scene's [record] names.
+const std::map<std::string, hal::RecordFormat> kFormats = {{"auto", hal::RecordFormat::kAuto},
+                                                           {"at2", hal::RecordFormat::kAt2},
+                                                           {"time-accel", hal::RecordFormat::kTimeAccel},
+                                                           {"accel", hal::RecordFormat::kAccel}};
+const std::map<std::string, hal::Units> kUnits = {
+    {"g", hal::Units::kG}, {"m/s2", hal::Units::kMps2}, {"cm/s2", hal::Units::kCmps2}};
+
+template <class E>
+std::vector<std::string> names_of(const std::map<std::string, E>& m) {
+  std::vector<std::string> out;
+  for (const auto& kv : m) out.push_back(kv.first);
+  return out;
+}
+
 struct RunArgs {
   std::string scene_path;
+  std::string record_format = "auto", record_units = "g";
   host::RunOptions opt;
   const CLI::Option* out = nullptr;  // --out, given or not
   bool accept_degraded = false;
@@ -22,6 +40,8 @@ struct RunArgs {
 int run(RunArgs a) {
   using namespace vines::host;
   RunOptions& opt = a.opt;
+  opt.record_reading.format = kFormats.at(a.record_format);
+  opt.record_reading.units = kUnits.at(a.record_units);
   const Scene scene = load_scene(a.scene_path);
   if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(scene.name);
   const RunReport r = run_scene(scene, opt);
@@ -66,9 +86,24 @@ void add_run(CLI::App& vines) {
                               "", [a] { return run(*a); });
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--record", a->opt.record_override,
-                  "use this ground-motion file instead of the scene's [record] path (format read from the file: "
-                  "PEER AT2 or columns; the scene's units, column and scale apply to columns)")
+                  "use this ground-motion file instead of the scene's [record] path; its format is read from "
+                  "the file (a PEER AT2 header, else time/accel columns, or one column of values); of the "
+                  "scene's [record], only scale / pga_g and duration_s apply to it")
       ->type_name("PATH");
+  // How to read the --record file (the names of the scene's [record] format and units).
+  auto* rec = cmd->get_option("--record");
+  cmd->add_option("--record-format", a->record_format, "force the --record file's format: auto (default), at2, "
+                                                       "time-accel or accel (values only, needs --record-dt)")
+      ->type_name("FORMAT")->check(CLI::IsMember(names_of(kFormats)))->needs(rec);
+  cmd->add_option("--record-units", a->record_units, "units of a --record columns file: g (default), m/s2 or "
+                                                     "cm/s2 (an AT2 file's header says its own)")
+      ->type_name("UNITS")->check(CLI::IsMember(names_of(kUnits)))->needs(rec);
+  host::RecordReading& how = a->opt.record_reading;
+  cmd->add_option("--record-column", how.column, "acceleration column of a --record time/accel file "
+                                                 "(1, the default, = the first after the time)")
+      ->type_name("N")->check(number_in(1, 1000))->needs(rec);
+  cmd->add_option("--record-dt", how.dt_s, "sample step of a --record file of values only [s]")
+      ->type_name("SECONDS")->check(positive_up_to(hal::kMaxRecordDt))->needs(rec);
   a->out = cmd->add_option("--out", a->opt.out_dir,
                            "output folder: new, empty or vines run's own; its files this run does not write are "
                            "removed (default: out/<scene name>)")

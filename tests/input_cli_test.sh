@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Bad inputs on the command line: each is refused at once (exit 1, or 2 for a
+# bad option value) with a message naming the input and why, never a hang:
+#   tests/input_cli_test.sh VINES SOURCE_DIR
+set -uo pipefail
+VINES=$(realpath "$1")
+SRC=$(realpath "$2")
+GM=$(realpath "$SRC/../shared/data/ground_motions")
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+cd "$SRC"
+failed=0
+
+# expect STATUS TEXT -- COMMAND...: the exit status, and TEXT in its stderr
+# (10 s at most: a hang fails).
+expect() {
+  local want=$1 text=$2
+  shift 3
+  timeout 10 "$@" > "$WORK/out" 2> "$WORK/err" < /dev/null
+  local rc=$?
+  if [ "$rc" -ne "$want" ] || { [ -n "$text" ] && ! grep -qF -- "$text" "$WORK/err"; }; then
+    echo "FAIL: $* -> exit $rc (want $want), stderr:"
+    cat "$WORK/err"
+    echo "  (wanted: $text)"
+    failed=$((failed + 1))
+  else
+    echo "ok:   $* -> $rc: $(head -n 1 "$WORK/err" | head -c 200)"
+  fi
+}
+
+# Scene files that are not files.
+expect 1 "/dev/zero: not a regular file" -- "$VINES" run /dev/zero
+expect 1 "data/scenes: is a directory" -- "$VINES" run data/scenes
+echo '[record]' | timeout 10 "$VINES" run /dev/stdin > /dev/null 2> "$WORK/err"
+if [ $? -ne 1 ] || ! grep -qF "/dev/stdin: not a regular file" "$WORK/err"; then
+  echo "FAIL: a pipe as the scene file"; cat "$WORK/err"; failed=$((failed + 1))
+fi
+expect 1 "/dev/zero: not a regular file" -- "$VINES" sweep /dev/zero --out "$WORK/s"
+
+# A scene whose record is a device, a record given as a device or folder.
+sed 's|^path = .*|path = "/dev/zero"|' data/scenes/elcentro_tmd.toml > "$WORK/dev_record.toml"
+expect 1 "record.path: \"/dev/zero\": /dev/zero (absolute) is not a regular file" -- "$VINES" run "$WORK/dev_record.toml"
+expect 1 "/dev/zero: not a regular file" -- "$VINES" run data/scenes/elcentro_tmd.toml --record /dev/zero
+expect 1 "$GM: is a directory" -- "$VINES" run data/scenes/elcentro_tmd.toml --record "$GM"
+
+# --record: values only need a dt; a forced format is used; a bad one is a usage error.
+awk 'NR <= 200 { print $2 }' "$GM/elcentro_1940_ns_2688pts_dt002_time_g.dat" > "$WORK/values.txt"
+expect 1 "one column of values and no time: give its sample step with --record-dt" -- \
+  "$VINES" run data/scenes/elcentro_tmd.toml --record "$WORK/values.txt" --out "$WORK/v"
+expect 0 "" -- "$VINES" run data/scenes/elcentro_tmd.toml --record "$WORK/values.txt" --record-dt 0.02 \
+  --out "$WORK/v" --quiet
+expect 1 "no 'NPTS= .., DT= ..' header line" -- \
+  "$VINES" run data/scenes/elcentro_tmd.toml --record "$WORK/values.txt" --record-format at2 --out "$WORK/v"
+expect 2 "--record-format" -- "$VINES" run data/scenes/elcentro_tmd.toml --record "$WORK/values.txt" \
+  --record-format nope
+expect 2 "--record-dt" -- "$VINES" run data/scenes/elcentro_tmd.toml --record "$WORK/values.txt" --record-dt 5
+
+# Scenes no run can keep: refused at load, naming the keys.
+sed -e '/^mass_ratio/d' -e 's|^\[vines\]|[vines]\nradius_m = 1e-6|' data/scenes/elcentro_vines.toml > "$WORK/tiny.toml"
+expect 1 "vines.radius_m: the Hertz contact lasts" -- "$VINES" run "$WORK/tiny.toml" --out "$WORK/t"
+sed 's|^\[vines\]|[vines]\nyoung_pa = 1|' data/scenes/elcentro_vines.toml > "$WORK/soft.toml"
+expect 1 "vines.young_pa: the Hertz overlap" -- "$VINES" run "$WORK/soft.toml" --out "$WORK/t"
+
+# In a sweep, a refused run is a row whose error names the key.
+sed '/^mass_ratio/d' data/scenes/elcentro_vines.toml > "$WORK/by_radius.toml"
+cat > "$WORK/study.toml" << EOF
+[[study]]
+name = "radius"
+scene = "by_radius.toml"
+[study.set]
+"loop.sensor_rate_hz" = 50.0
+"output.rate_hz" = 50.0
+"record.duration_s" = 1.0
+[study.grid]
+"vines.radius_m" = [1e-6, 1.0]
+EOF
+timeout 60 "$VINES" sweep "$WORK/study.toml" --out "$WORK/sweep" --no-progress > /dev/null 2>&1
+if ! grep -q 'vines.radius_m: the Hertz contact lasts' "$WORK/sweep/results.csv"; then
+  echo "FAIL: the refused sweep run's error is not in results.csv:"; cat "$WORK/sweep/results.csv"
+  failed=$((failed + 1))
+fi
+
+echo "input_cli: $failed failed"
+[ "$failed" -eq 0 ]
