@@ -51,12 +51,15 @@ grep -q "notes.txt" "$tmp/err.txt" || fail "the refusal does not name notes.txt:
 [[ -f $tmp/run/notes.txt ]] || fail "notes.txt removed"
 echo "run: stale timeseries.csv removed, a folder with a foreign file refused"
 
-# vines sweep: results.csv fails; the earlier results.csv and summary.json stay whole.
+# vines sweep: its log of finished runs (runs.jsonl, the new sweep's own) fails
+# first; the earlier results.csv and summary.json stay whole.
 spec=$src/tests/data/mini_sweep.toml
 "$vines" sweep "$spec" --threads 2 --out "$tmp/sweep" --no-progress > /dev/null
 cp -r "$tmp/sweep" "$tmp/sweep.before"
-expect_efbig "$tmp/sweep/results.csv" "$vines" sweep "$spec" --threads 2 --out "$tmp/sweep" --no-progress
-diff -r "$tmp/sweep.before" "$tmp/sweep" > /dev/null || fail "vines sweep: earlier results changed by a failed sweep"
+expect_efbig "$tmp/sweep/runs.jsonl" "$vines" sweep "$spec" --threads 2 --out "$tmp/sweep" --no-progress
+for f in results.csv summary.json; do
+  cmp -s "$tmp/sweep.before/$f" "$tmp/sweep/$f" || fail "vines sweep: earlier $f changed by a failed sweep"
+done
 no_temp "$tmp/sweep"
 echo "sweep: write failure reported, earlier results intact"
 
