@@ -27,6 +27,7 @@ class Writer {
       overflow_ = true;
       return;
     }
+    if (n == 0) return;  // an empty payload may come as a null pointer (memcpy must not get one)
     std::memcpy(buf_ + len_, p, n);
     len_ += n;
   }
