@@ -14,11 +14,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "host/record.hpp"
 #include "sim_host/scene_toml.hpp"
 
 namespace vines::host {
@@ -91,11 +91,8 @@ std::string plan_fingerprint(const SweepSpec& spec, const std::vector<RunPlan>& 
 }
 
 SweepLogContents read_sweep_log(const std::string& file, const std::string& fingerprint, std::size_t runs) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(file + ": cannot read: " + std::strerror(errno));
-  std::stringstream buf;
-  buf << in.rdbuf();
-  const std::string text = buf.str();
+  // A regular file, read whole (no size bound: a --large plan's log may be big).
+  const std::string text = hal::read_input_file(file, std::numeric_limits<std::uintmax_t>::max());
   SweepLogContents out;
   out.results.resize(runs);
   std::size_t line_no = 0;

@@ -1,14 +1,14 @@
 // Shared pieces of the commands: registration, number lists and ranges, Ctrl-C.
 #include "sim_host/cli/cli.hpp"
 
-#include <cmath>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <limits>
 #include <utility>
 
