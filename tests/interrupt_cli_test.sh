@@ -11,14 +11,14 @@ src=$2
 tmp=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$tmp"' EXIT
 
-# Runs of about a second each: El Centro at a 20 kHz sensor rate.
+# Runs of about a second each (on an idle core): El Centro at a 100 kHz sensor rate.
 spec=$tmp/long.toml
 cat > "$spec" <<EOF
 [[study]]
 name = "long"
 scene = "$src/data/scenes/elcentro_vines.toml"
 [study.set]
-"loop.sensor_rate_hz" = 20000.0
+"loop.sensor_rate_hz" = 100000.0
 "output.rate_hz" = 50.0
 [study.grid]
 "vines.beta" = [1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9]
@@ -50,9 +50,9 @@ wait_exit() {
 }
 rows() { echo $(($(wc -l < "$1") - 1)); }
 
-# Ctrl-C in the middle of runs of several seconds (100 kHz): they are
+# Ctrl-C in the middle of runs of several seconds (1 MHz): they are
 # dropped, the sweep exits within a second.
-sed 's/20000.0/100000.0/; s/^"vines.beta" = .*/"vines.beta" = [1.3, 1.4]/' "$spec" > "$tmp/longer.toml"
+sed 's/100000.0/1000000.0/; s/^"vines.beta" = .*/"vines.beta" = [1.3, 1.4]/' "$spec" > "$tmp/longer.toml"
 "$vines" sweep "$tmp/longer.toml" --threads 2 --out "$tmp/mid" --no-progress > /dev/null 2>&1 &
 pid=$!
 sleep 1
