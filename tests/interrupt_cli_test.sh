@@ -50,9 +50,9 @@ wait_exit() {
 }
 rows() { echo $(($(wc -l < "$1") - 1)); }
 
-# Ctrl-C in the middle of runs of several seconds (1 MHz): they are
+# Ctrl-C in the middle of runs of several seconds (300 kHz): they are
 # dropped, the sweep exits within a second.
-sed 's/100000.0/1000000.0/; s/^"vines.beta" = .*/"vines.beta" = [1.3, 1.4]/' "$spec" > "$tmp/longer.toml"
+sed 's/100000.0/300000.0/; s/^"vines.beta" = .*/"vines.beta" = [1.3, 1.4]/' "$spec" > "$tmp/longer.toml"
 "$vines" sweep "$tmp/longer.toml" --threads 2 --out "$tmp/mid" --no-progress > /dev/null 2>&1 &
 pid=$!
 sleep 1
