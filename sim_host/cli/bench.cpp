@@ -2,12 +2,14 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/bench.hpp"
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/csv.hpp"
+#include "sim_host/reference/truth.hpp"
 #include "sim_host/scene.hpp"
 #include "vines/params.hpp"
 
@@ -44,6 +46,11 @@ int bench(BenchArgs a) {
   // The table has CVODE baselines by default; --json alone is the scene's own line.
   if (a.baselines->count() == 0 && !a.as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
   if (a.no_baselines) opt.baseline_rtols.clear();
+  // Refused before any run: a table without the lines it was asked for is a silent wrong result.
+  if (!opt.baseline_rtols.empty() && *reference::cvode_missing())
+    throw std::runtime_error(std::string("the CVODE baselines (") +
+                             (a.baselines->count() ? "--baselines" : "the table's default, 1e-6,1e-8,1e-10") +
+                             "): " + reference::cvode_missing() + "; or leave them out with --no-baselines");
   std::vector<BenchLine> lines;
   for (const std::string& path : a.scenes) {
     const Scene scene = load_scene(path);
