@@ -48,11 +48,11 @@ void print_stress(const host::StressSummary& s, const host::StressRun& run,
               "%d thread%s\n",
               s.cases, static_cast<unsigned long long>(s.seed), s.refused, s.failed, s.degraded, s.wall_s,
               s.cases_per_s(), threads, threads > 1 ? "s" : "");
-  // The frames drawn from: those of this build (tools/main.sh builds none of the extra stress frames).
+  // The frames drawn from: those of this build (tools/main.sh builds the 10-story frame only).
   const bool extra = compiled_frames(Scalar::kDouble, DeviceKind::kNone) != compiled_frames(Scalar::kDouble, DeviceKind::kTmd);
   std::printf("frames: %s%s\n", compiled_story_counts().c_str(),
-              extra ? "" : "; no extra stress frames in this build: `cmake --preset release` and rebuild for 3, 20 "
-                           "and 40 stories");
+              extra ? "" : "; no extra stress frames in this build: `cmake --preset release` and rebuild for the "
+                           "release preset's 1, 3, 10, 20 and 40 stories");
   std::printf("\n%-12s %6s %7s %12s %12s\n", "check", "runs", "failed", "worst", "bound");
   for (int c : checks_by_name()) {
     const CheckSummary& k = s.checks[static_cast<std::size_t>(c)];
