@@ -6,8 +6,9 @@ and prints, for each loop.contact_rtol, the grid's statistics of x_r and E_r
 (mean and sample sd over its ok runs, in %), how far each statistic is from
 the tightest tolerance's, and the per-run spread against the tightest
 tolerance (median and 90th percentile of |x_r - x_r(tightest)| over the
-runs ok at both). A row exits 1 naming the file when the file is missing,
-has no such study, or a tolerance has no ok run.
+runs ok at both), and the largest energy balance residual (when the runs
+computed it). Exits 1 naming the file when it is missing, has no such
+study, or no ok run.
 
     /usr/bin/python3 tools/tolerance_table.py DIR [--study ic_vines_rtol]
 """
@@ -51,12 +52,15 @@ def main():
     if KEY not in rows[0]:
         fail(f"{path}: no column '{KEY}' (not a tolerance study)")
     others = [c for c in rows[0] if c.startswith(("vines.", "tmd.", "record."))]
-    by_tol = {}
+    by_tol, residual = {}, {}
     for r in rows:
         if r.get("status") != "ok":
             continue
         point = tuple(r[c] for c in others)
-        by_tol.setdefault(float(r[KEY]), {})[point] = (100 * float(r["x_r"]), 100 * float(r["E_r"]))
+        tol = float(r[KEY])
+        by_tol.setdefault(tol, {})[point] = (100 * float(r["x_r"]), 100 * float(r["E_r"]))
+        if r.get("energy_balance_residual"):
+            residual[tol] = max(residual.get(tol, 0.0), abs(float(r["energy_balance_residual"])))
     if not by_tol:
         fail(f"{path}: no ok run in study '{args.study}'")
     tight = min(by_tol)
@@ -64,8 +68,9 @@ def main():
     ref_x = statistics.mean(v[0] for v in ref.values())
     ref_e = statistics.mean(v[1] for v in ref.values())
     print(f"| contact_rtol | runs ok | x_r % mean +- sd | E_r % mean +- sd | mean x_r - tightest | "
-          f"mean E_r - tightest | per-run abs dx_r median / p90 | per-run abs dE_r median / p90 |")
-    print("|---|---|---|---|---|---|---|---|")
+          f"mean E_r - tightest | per-run abs dx_r median / p90 | per-run abs dE_r median / p90 | "
+          f"max energy residual |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for tol in sorted(by_tol, reverse=True):
         runs = by_tol[tol]
         xs = [v[0] for v in runs.values()]
@@ -78,7 +83,8 @@ def main():
         de = [abs(runs[p][1] - ref[p][1]) for p in both]
         print(f"| {tol:g} | {len(runs)} | {mx:.2f} +- {sx:.2f} | {me:.2f} +- {se:.2f} | {mx - ref_x:+.3f} | "
               f"{me - ref_e:+.3f} | {percentile(dx, 0.5):.2g} / {percentile(dx, 0.9):.2g} | "
-              f"{percentile(de, 0.5):.2g} / {percentile(de, 0.9):.2g} |")
+              f"{percentile(de, 0.5):.2g} / {percentile(de, 0.9):.2g} | "
+              f"{format(residual[tol], '.2g') if tol in residual else 'not computed'} |")
 
 
 if __name__ == "__main__":
