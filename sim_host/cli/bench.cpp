@@ -41,7 +41,7 @@ void write_csv(const std::string& path, const std::vector<host::BenchLine>& line
 int bench(BenchArgs a) {
   using namespace vines::host;
   BenchOptions& opt = a.opt;
-  // The table has CVODE baselines by default; --json alone is the scene's own line.
+  // The table has baselines by default; --json alone is the scene's own line.
   if (a.baselines->count() == 0 && !a.as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
   if (a.no_baselines) opt.baseline_rtols.clear();
   std::vector<BenchLine> lines;
@@ -95,9 +95,15 @@ void add_bench(CLI::App& vines) {
                   "bounded scheme: sub-step budgets per sensor step, integers in [2, 64] (default: the scene's "
                   "loop.bounded_substeps)");
   a->baselines = add_number_list(*cmd, "--baselines", &opt.baseline_rtols,
-                                 "SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the record's own points "
-                                 "(default 1e-6,1e-8,1e-10; none with --json)");
-  cmd->add_flag("--no-baselines", a->no_baselines, "no CVODE lines");
+                                 "baseline lines (see --baseline-methods) at these tolerances, fed the record's own "
+                                 "points (default 1e-6,1e-8,1e-10; none with --json)");
+  cmd->add_option("--baseline-methods", opt.baseline_methods,
+                  "baselines: dop853 (DOP853 with event location, double), cvode-adams, cvode-bdf (SUNDIALS "
+                  "CVODE) (default: all three)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"dop853", "cvode-adams", "cvode-bdf"}));
+  cmd->add_flag("--no-baselines", a->no_baselines, "no baseline lines");
   cmd->add_option("--min-time", opt.min_time_s, "time each line for at least S seconds (default 0.3)")
       ->type_name("S")
       ->check(positive_up_to(std::numeric_limits<double>::max()));
