@@ -106,8 +106,15 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   return l;
 }
 
-// One baseline line: CVODE on the record's own points.
-BenchLine baseline_line(const Scene& base, reference::Method method, double rtol, const Truth& truth,
+reference::Method baseline_method(const std::string& name) {
+  if (name == "dop853") return reference::Method::kDop853;
+  if (name == "cvode-adams") return reference::Method::kCvodeAdams;
+  if (name == "cvode-bdf") return reference::Method::kCvodeBdf;
+  throw std::runtime_error("--baseline-methods: unknown method '" + name + "' (dop853, cvode-adams, cvode-bdf)");
+}
+
+// One baseline line (DOP853 in double or CVODE) on the record's own points.
+BenchLine baseline_line(const Scene& base, const std::string& method, double rtol, const Truth& truth,
                         const BenchOptions& opt) {
   Scene scene = base;
   const hal::Record rec = load_excitation(scene, "").record;
@@ -115,7 +122,7 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
   const Excitation ex = load_excitation(scene, "");
   BenchLine l;
   l.scene = scene.name;
-  l.method = method == reference::Method::kCvodeAdams ? "cvode-adams" : "cvode-bdf";
+  l.method = method;
   l.scalar = "double";
   l.rate_hz = ex.rate_hz;
   l.rtol = rtol;
@@ -123,7 +130,7 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
   o.rtol = rtol;
   reference::Result r;
   time_line(opt, 1000, [&] {
-    r = reference::integrate(scene.params, ex.samples, ex.rate_hz, method, o);
+    r = reference::integrate(scene.params, ex.samples, ex.rate_hz, baseline_method(method), o);
     return r.wall_s;
   }, &l);
   l.steps = r.steps;
@@ -137,6 +144,8 @@ BenchLine baseline_line(const Scene& base, reference::Method method, double rtol
 }
 
 }  // namespace
+
+const char* const kBaselineMethods[3] = {"dop853", "cvode-adams", "cvode-bdf"};
 
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);
@@ -195,8 +204,13 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
           throw std::runtime_error("--schemes: unknown contact scheme '" + scheme + "' (adaptive, bounded)");
         }
       }
-  for (reference::Method m : {reference::Method::kCvodeAdams, reference::Method::kCvodeBdf})
+  // Baselines in table order, whatever the order asked.
+  for (const std::string& m : opt.baseline_methods) baseline_method(m);
+  for (const char* m : kBaselineMethods) {
+    const auto& asked = opt.baseline_methods;
+    if (!asked.empty() && std::find(asked.begin(), asked.end(), m) == asked.end()) continue;
     for (double rtol : opt.baseline_rtols) lines.push_back(baseline_line(scene, m, rtol, truth, opt));
+  }
   return lines;
 }
 

@@ -3,7 +3,8 @@
 // firmware loop (record already loaded, model already built; median of
 // repeats) and measures their error against the converged reference
 // (data/reference/<scene>.json, written by `vines reference`). Baselines
-// (SUNDIALS CVODE on the same model) run in the same process.
+// (DOP853 with event location in double, SUNDIALS CVODE Adams and BDF, on
+// the same model) run in the same process.
 #pragma once
 
 #include <string>
@@ -28,7 +29,7 @@ struct Truth {
 
 // One line of the work-precision table.
 struct BenchLine {
-  std::string scene, method, scalar;  // method: "firmware", "cvode-adams", "cvode-bdf"
+  std::string scene, method, scalar;  // method: "firmware", "dop853", "cvode-adams", "cvode-bdf"
   // Firmware lines: the contact scheme ("adaptive", "bounded") and, bounded,
   // its sub-step budget; the most sub-steps any step took.
   std::string scheme = "adaptive";
@@ -59,10 +60,15 @@ struct BenchOptions {
   // contacts), as a study does. On: the scene's own outputs (per-floor
   // peaks, energy ledger) are computed too.
   bool full_outputs = false;
-  // SUNDIALS CVODE (Adams and BDF) on the same model at these tolerances, fed
-  // the record's own points (the same piecewise-linear input); empty: none.
+  // Baselines on the same model at these tolerances, fed the record's own
+  // points (the same piecewise-linear input); empty: none.
   std::vector<double> baseline_rtols;
+  // Which baselines ("dop853", "cvode-adams", "cvode-bdf"); empty: all three.
+  std::vector<std::string> baseline_methods;
 };
+
+// The baseline methods by name, in table order.
+extern const char* const kBaselineMethods[3];
 
 // The scene's reference, or an unknown truth if there is none on file.
 Truth load_truth(const Scene& scene, const std::string& reference_dir);

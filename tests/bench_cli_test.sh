@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `vines bench SCENE --json`: one JSON object for the scene's own settings,
 # measured against data/reference: the El Centro Kuwabara scene must be within
-# 1e-6 of the reference peak with the reference's 18 contacts; a bad option
-# and a missing scene are refused with a message; CVODE baselines (below).
+# 1e-6 of the reference peak with the reference's 18 contacts; the dop853
+# baseline alone; a bad option, an unknown baseline and a missing scene are
+# refused with a message; CVODE baselines (below).
 set -euo pipefail
 vines="$1"
 src="$2"
@@ -18,6 +19,24 @@ assert j["peak_rel_error"] is not None and j["peak_rel_error"] < 1e-6, j["peak_r
 assert j["contacts"] == 18, j["contacts"]
 print("bench_cli: peak error %.2e, %d contacts, %.3f ms" % (j["peak_rel_error"], j["contacts"], 1e3 * j["wall_s_median"]))
 '
+# --baseline-methods dop853: the firmware line, then one DOP853 (double) line
+# on the record's own 50 Hz points, near the reference at 1e-10.
+out=$("$vines" bench "$src/data/scenes/elcentro_vines.toml" --json --min-time 0.01 --baselines 1e-10 \
+  --baseline-methods dop853)
+printf '%s\n' "$out" | /usr/bin/python3 -c '
+import json, sys
+ls = json.load(sys.stdin)["lines"]
+assert [l["method"] for l in ls] == ["firmware", "dop853"], [l["method"] for l in ls]
+d = ls[1]
+assert d["scalar"] == "double" and d["sensor_rate_hz"] == 50 and d["contact_rtol"] == 1e-10, d
+assert d["peak_rel_error"] is not None and d["peak_rel_error"] < 1e-7, d["peak_rel_error"]
+assert d["contacts"] == 18, d["contacts"]
+print("bench_cli: dop853 1e-10 peak error %.2e, %.2f ms" % (d["peak_rel_error"], 1e3 * d["wall_s_median"]))
+'
+if "$vines" bench "$src/data/scenes/elcentro_vines.toml" --baseline-methods rk4 2>/tmp/bench_cli_err.txt; then
+  echo "bench_cli: --baseline-methods rk4 was accepted" >&2; exit 1
+fi
+grep -q -- "--baseline-methods" /tmp/bench_cli_err.txt
 if "$vines" bench "$src/data/scenes/elcentro_vines.toml" --rates fifty 2>/tmp/bench_cli_err.txt; then
   echo "bench_cli: --rates fifty was accepted" >&2; exit 1
 fi
@@ -30,12 +49,13 @@ grep -q "nonexistent.toml" /tmp/bench_cli_err.txt
 # without (VINES_TEST_CVODE=0), refused (exit 1) saying how to get them.
 scene="$src/data/scenes/elcentro_vines.toml"
 if [[ ${VINES_TEST_CVODE:?} == 1 ]]; then
-  "$vines" bench "$scene" --json --min-time 0.05 --baselines 1e-6 | /usr/bin/python3 -c '
+  "$vines" bench "$scene" --json --min-time 0.05 --baselines 1e-6 --baseline-methods cvode-adams,cvode-bdf |
+    /usr/bin/python3 -c '
 import json, sys
 methods = sorted(l["method"] for l in json.load(sys.stdin)["lines"])
 assert methods == ["cvode-adams", "cvode-bdf", "firmware"], methods'
 else
-  for args in "--baselines 1e-6" ""; do
+  for args in "--baselines 1e-6" "--baselines 1e-6 --baseline-methods cvode-bdf" ""; do
     status=0
     "$vines" bench "$scene" --min-time 0.05 $args >/dev/null 2>/tmp/bench_cli_err.txt || status=$?
     if [[ $status != 1 ]]; then
@@ -44,5 +64,6 @@ else
     grep -q "no CVODE.*libsundials-dev" /tmp/bench_cli_err.txt
   done
   "$vines" bench "$scene" --min-time 0.05 --no-baselines >/dev/null
+  "$vines" bench "$scene" --min-time 0.05 --baselines 1e-8 --baseline-methods dop853 >/dev/null
 fi
 echo "bench_cli: ok"

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim_host/bench.hpp"
 #include "sim_host/reference/frame.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/reference/truth.hpp"
@@ -214,6 +215,10 @@ TEST(ReferenceInput, BadInputIsAClearException) {
   Options o;
   o.rtol = 1e-20;
   EXPECT_NE(message(p, a, 50, Method::kReference, o).find("rtol"), std::string::npos);
+  o.rtol = 1e-14;  // fine for the long-double reference, below what double can honour
+  EXPECT_EQ(message(p, a, 50, Method::kReference, o), "no exception");
+  EXPECT_NE(message(p, a, 50, Method::kDop853, o).find("rtol 1e-14 out of range for DOP853 (double)"),
+            std::string::npos);
   o.rtol = 0;
   o.duration_s = -1;
   EXPECT_NE(message(p, a, 50, Method::kReference, o).find("duration"), std::string::npos);
@@ -323,6 +328,40 @@ TEST(ReferenceSlow, StoredFilesEqualAFreshRun) {
   }
 }
 
+// The `dop853` baseline of `vines bench` (the reference's driver in double,
+// on the record's own 50 Hz points) against data/reference/elcentro_vines.json
+// (the long-double run at 1e-15): its peak and E_e errors fall with its
+// tolerance, and at 1e-12 it is the reference (peak to 1e-9, same contacts).
+TEST(ReferenceSlow, Dop853BaselineConvergesToTheStoredReference) {
+  const host::Scene scene = host::load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml");
+  host::BenchOptions opt;
+  opt.scalars = {"double"};
+  opt.min_time_s = 0;
+  opt.min_runs = 1;
+  opt.baseline_methods = {"dop853"};
+  opt.baseline_rtols = {1e-6, 1e-9, 1e-12};
+  const std::vector<host::BenchLine> lines = host::bench_scene(scene, opt);
+  ASSERT_EQ(lines.size(), 4u);  // the firmware line, then the three baselines
+  const host::Truth truth = host::load_truth(scene, "");
+  ASSERT_TRUE(truth.known);
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const host::BenchLine& l = lines[i];
+    std::printf("[ measured ] dop853 rtol %.0e: peak err %.2e, E_e err %.2e, contacts %d, %lld steps, %.2f ms\n",
+                l.rtol, l.peak_rel_error, l.elastic_energy_rel_error, l.contacts, l.steps, 1e3 * l.wall_median_s);
+    EXPECT_EQ(l.method, "dop853");
+    EXPECT_EQ(l.scalar, "double");
+    EXPECT_EQ(l.rate_hz, 50.0);  // the record's own points
+    if (i > 1) {
+      EXPECT_LT(l.peak_rel_error, 0.1 * lines[i - 1].peak_rel_error) << l.rtol;
+      EXPECT_GT(l.steps, lines[i - 1].steps) << l.rtol;
+    }
+  }
+  const host::BenchLine& tight = lines.back();
+  EXPECT_LT(tight.peak_rel_error, 1e-9);
+  EXPECT_LT(tight.elastic_energy_rel_error, 1e-6);
+  EXPECT_EQ(tight.contacts, truth.contacts);
+}
+
 #ifdef VINES_HAVE_CVODE
 // CVODE at rtol 1e-8: the peak (reached at 5.57 s) to 1e-5. Contacts: the
 // motion is chaotic, so after ~40 s the trajectories part; compare the
@@ -346,7 +385,7 @@ TEST(ReferenceSlow, CvodeAgreesWithTheReference) {
 }
 #else
 // A build without SUNDIALS: asking for CVODE is refused, saying how to get it
-// (and the reference still integrates).
+// (and the reference and the DOP853 baseline still integrate).
 TEST(Reference, WithoutCvodeSaysHowToGetIt) {
   const SceneParams p = test::paper_scene(DeviceKind::kVines);
   const std::vector<double> a = {0.0, 1.0, 0.0};
@@ -360,6 +399,7 @@ TEST(Reference, WithoutCvodeSaysHowToGetIt) {
     }
   }
   EXPECT_GT(integrate(p, a, 50, Method::kReference, {}).steps, 0);
+  EXPECT_GT(integrate(p, a, 50, Method::kDop853, {}).steps, 0);
 }
 #endif
 

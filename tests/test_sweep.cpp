@@ -95,6 +95,38 @@ TEST(Studies, InitialConditionGridMatchesTable2) {
   EXPECT_NEAR(mean(er), 0.605, 0.03);
 }
 
+// The IC grid states its contact tolerance (data/studies/tolerance.toml is
+// the study behind it): at that tolerance the grid's statistics are those of
+// a converged grid (1e-12) to the 0.01 points the study reports (checked at
+// 0.02 points, x_r and E_r, mean and sd).
+TEST(Studies, InitialConditionGridToleranceGivesConvergedStatistics) {
+  Sweep stated("initial_conditions.toml", {"ic_vines"});
+  double rtol = 0;
+  for (const KeyValue& kv : stated.spec.studies[0].set)
+    if (kv.key == "loop.contact_rtol") rtol = kv.number;
+  ASSERT_GT(rtol, 1e-12) << "ic_vines states no loop.contact_rtol";
+  SweepSpec tight = stated.spec;
+  for (KeyValue& kv : tight.studies[0].set)
+    if (kv.key == "loop.contact_rtol") kv.number = 1e-12;
+  const std::vector<RunPlan> plan = plan_runs(tight);
+  const std::vector<RunResult> converged = execute(tight, plan, 2, 0, 1, nullptr, false);
+  std::vector<double> xr, er, xr_c, er_c;
+  for (const auto& [v, r] : stated.by(0, "")) {
+    xr.push_back(r.x_r);
+    er.push_back(r.E_r);
+  }
+  for (const RunResult& r : converged) {
+    ASSERT_TRUE(r.error.empty() && !r.degraded) << r.error << r.degraded_reasons;
+    xr_c.push_back(r.x_r);
+    er_c.push_back(r.E_r);
+  }
+  ASSERT_EQ(xr.size(), xr_c.size());
+  EXPECT_NEAR(mean(xr), mean(xr_c), 2e-4) << "rtol " << rtol;
+  EXPECT_NEAR(sd(xr), sd(xr_c), 2e-4) << "rtol " << rtol;
+  EXPECT_NEAR(mean(er), mean(er_c), 2e-4) << "rtol " << rtol;
+  EXPECT_NEAR(sd(er), sd(er_c), 2e-4) << "rtol " << rtol;
+}
+
 TEST(Studies, DamageHurtsTheTmdNotTheVines) {
   const Sweep sw("damage.toml");
   bool tmd_negative = false;

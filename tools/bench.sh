@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Work-precision benchmark: every El Centro scene, both scalars, sensor rates
-# and contact sub-step tolerances swept, SUNDIALS CVODE (Adams, BDF) as the
-# baseline, all against data/reference. Writes out/bench/bench.csv, prints the
+# and contact sub-step tolerances swept, DOP853 with event location (double)
+# and SUNDIALS CVODE (Adams, BDF) as the baselines, all against data/reference. Writes out/bench/bench.csv, prints the
 # table, and plots out/bench/work_precision.png (error against wall time).
 # Options are passed on to `vines bench` (e.g. --min-time 1).
 set -euo pipefail

@@ -1,4 +1,5 @@
 // `vines bench SCENE.toml...`: speed against accuracy, against data/reference.
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -43,14 +44,19 @@ void write_csv(const std::string& path, const std::vector<host::BenchLine>& line
 int bench(BenchArgs a) {
   using namespace vines::host;
   BenchOptions& opt = a.opt;
-  // The table has CVODE baselines by default; --json alone is the scene's own line.
+  // The table has baselines by default; --json alone is the scene's own line.
   if (a.baselines->count() == 0 && !a.as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
   if (a.no_baselines) opt.baseline_rtols.clear();
   // Refused before any run: a table without the lines it was asked for is a silent wrong result.
-  if (!opt.baseline_rtols.empty() && *reference::cvode_missing())
+  const std::vector<std::string>& methods = opt.baseline_methods;
+  const bool cvode = methods.empty() || std::any_of(methods.begin(), methods.end(), [](const std::string& m) {
+                       return m.rfind("cvode", 0) == 0;
+                     });
+  if (!opt.baseline_rtols.empty() && cvode && *reference::cvode_missing())
     throw std::runtime_error(std::string("the CVODE baselines (") +
-                             (a.baselines->count() ? "--baselines" : "the table's default, 1e-6,1e-8,1e-10") +
-                             "): " + reference::cvode_missing() + "; or leave them out with --no-baselines");
+                             (methods.empty() ? "--baseline-methods default: all three" : "--baseline-methods") +
+                             "): " + reference::cvode_missing() +
+                             "; or leave them out with --baseline-methods dop853 or --no-baselines");
   std::vector<BenchLine> lines;
   for (const std::string& path : a.scenes) {
     const Scene scene = load_scene(path);
@@ -102,9 +108,15 @@ void add_bench(CLI::App& vines) {
                   "bounded scheme: sub-step budgets per sensor step, integers in [2, 64] (default: the scene's "
                   "loop.bounded_substeps)");
   a->baselines = add_number_list(*cmd, "--baselines", &opt.baseline_rtols,
-                                 "SUNDIALS CVODE Adams and BDF lines at these tolerances, fed the record's own points "
-                                 "(default 1e-6,1e-8,1e-10; none with --json)");
-  cmd->add_flag("--no-baselines", a->no_baselines, "no CVODE lines");
+                                 "baseline lines (see --baseline-methods) at these tolerances, fed the record's own "
+                                 "points (default 1e-6,1e-8,1e-10; none with --json)");
+  cmd->add_option("--baseline-methods", opt.baseline_methods,
+                  "baselines: dop853 (DOP853 with event location, double), cvode-adams, cvode-bdf (SUNDIALS "
+                  "CVODE) (default: all three)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"dop853", "cvode-adams", "cvode-bdf"}));
+  cmd->add_flag("--no-baselines", a->no_baselines, "no baseline lines");
   cmd->add_option("--min-time", opt.min_time_s, "time each line for at least S seconds (default 0.3)")
       ->type_name("S")
       ->check(positive_up_to(std::numeric_limits<double>::max()));

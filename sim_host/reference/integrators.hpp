@@ -80,7 +80,10 @@ bool take_event(Mode& mode, int side, const SceneOde<T>& ode, T* y, Tally& tally
   return vines::take_event(mode, side, ode.restitution(), act);
 }
 
-Result integrate_reference(const OdeSpec& spec, const Ground& g, double rtol);
+// DOP853 with event location in scalar T (long double: the reference;
+// double: the bench baseline); instantiated for those two.
+template <typename T>
+Result integrate_dop853(const OdeSpec& spec, const Ground& g, double rtol);
 Result integrate_cvode(const OdeSpec& spec, const Ground& g, double rtol, bool bdf);
 
 // Stationary points in (0, 1) of the cubic Hermite interpolant on a step of

@@ -1,7 +1,8 @@
-// The reference integrator: DOP853 in long double over each sample interval
-// (a_g is linear inside, kinked at the samples), events located by re-taking
-// the step from its start with an Illinois-secant step length, to a bracket
-// of a few long-double ulps of the time.
+// The DOP853 driver, templated on the scalar: long double for the reference
+// (`vines reference`), double for the `dop853` baseline of `vines bench`.
+// DOP853 over each sample interval (a_g is linear inside, kinked at the
+// samples), events located by re-taking the step from its start with an
+// Illinois-secant step length, to a bracket of a few ulps of the time.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,19 +17,23 @@
 namespace vines::host::reference {
 namespace {
 
-using T = long double;
+template <typename T>
 using State = std::vector<T>;
 
 // Two states bracketing a located root: g <= 0 at lo, g > 0 at hi (step
 // lengths from the current step start).
+template <typename T>
 struct Bracket {
   T lo = 0, hi = 0;
-  State ylo, flo, yhi, fhi;
+  State<T> ylo, flo, yhi, fhi;
   T err_hi = 0;  // error norm of the re-step to hi
 };
 
+template <typename T>
 class ReferenceRun {
  public:
+  using State = reference::State<T>;
+  using Bracket = reference::Bracket<T>;
   ReferenceRun(const OdeSpec& spec, const Ground& g, T rtol)
       : ode_(spec), g_(g), rk_(ode_.size()), rtol_(rtol), atol_(ode_.scales()),
         y_(static_cast<std::size_t>(ode_.size())), f_(y_), y1_(y_), f1_(y_), tmp_(y_), ftmp_(y_) {
@@ -280,8 +285,11 @@ class ReferenceRun {
 
 }  // namespace
 
-Result integrate_reference(const OdeSpec& spec, const Ground& g, double rtol) {
-  return ReferenceRun(spec, g, static_cast<T>(rtol)).run();
+template <typename T>
+Result integrate_dop853(const OdeSpec& spec, const Ground& g, double rtol) {
+  return ReferenceRun<T>(spec, g, static_cast<T>(rtol)).run();
 }
+template Result integrate_dop853<long double>(const OdeSpec&, const Ground&, double);
+template Result integrate_dop853<double>(const OdeSpec&, const Ground&, double);
 
 }  // namespace vines::host::reference

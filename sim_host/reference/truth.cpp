@@ -10,9 +10,9 @@ namespace vines::host::reference {
 namespace {
 
 // Tolerances each method can honour: the reference well above long-double
-// rounding, CVODE well above double rounding.
+// rounding, DOP853 in double and CVODE well above double rounding.
 constexpr double kReferenceDefault = 1e-15, kReferenceMin = 1e-17;
-constexpr double kCvodeDefault = 1e-8, kCvodeMin = 1e-13;
+constexpr double kDoubleDefault = 1e-8, kDoubleMin = 1e-13;
 constexpr double kMaxRtol = 1e-2;
 
 std::string num(double x) {
@@ -45,6 +45,7 @@ Ground check_ground(const std::vector<double>& samples, double rate_hz, double d
 const char* method_name(Method m) {
   switch (m) {
     case Method::kReference: return "reference (DOP853, long double)";
+    case Method::kDop853: return "DOP853 (double)";
     case Method::kCvodeAdams: return "CVODE Adams (fixed point)";
     default: return "CVODE BDF (Newton, dense)";
   }
@@ -63,18 +64,21 @@ Result integrate(const SceneParams& p, const std::vector<double>& samples, doubl
                  const Options& o) {
   const Ground g = check_ground(samples, sample_rate_hz, o.duration_s);
   const bool ref = m == Method::kReference;
-  const double rtol = o.rtol > 0.0 ? o.rtol : ref ? kReferenceDefault : kCvodeDefault;
-  const double lo = ref ? kReferenceMin : kCvodeMin;
+  const double rtol = o.rtol > 0.0 ? o.rtol : ref ? kReferenceDefault : kDoubleDefault;
+  const double lo = ref ? kReferenceMin : kDoubleMin;
   if (!(rtol >= lo && rtol <= kMaxRtol))
     throw std::runtime_error(std::string("rtol ") + num(o.rtol) + " out of range for " + method_name(m) + ": [" +
                              num(lo) + ", " + num(kMaxRtol) + "]");
   const OdeSpec spec = make_spec(p);
-  if (!ref && *cvode_missing()) throw std::runtime_error(std::string(method_name(m)) + ": " + cvode_missing());
+  const bool cvode = m == Method::kCvodeAdams || m == Method::kCvodeBdf;
+  if (cvode && *cvode_missing()) throw std::runtime_error(std::string(method_name(m)) + ": " + cvode_missing());
   const auto t0 = std::chrono::steady_clock::now();
 #ifdef VINES_HAVE_CVODE
-  Result r = ref ? integrate_reference(spec, g, rtol) : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
+  Result r = ref                    ? integrate_dop853<long double>(spec, g, rtol)
+             : m == Method::kDop853 ? integrate_dop853<double>(spec, g, rtol)
+                                    : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
 #else
-  Result r = integrate_reference(spec, g, rtol);
+  Result r = ref ? integrate_dop853<long double>(spec, g, rtol) : integrate_dop853<double>(spec, g, rtol);
 #endif
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -3,6 +3,8 @@
 //    (a_g has a kink there), events located to long-double rounding by
 //    re-stepping (Illinois), the peak of |x_top| at the located zeros of the
 //    top-floor velocity;
+//  - kDop853: the same driver in double (the `dop853` baseline of `vines
+//    bench`: DOP853 with event location at a working tolerance);
 //  - kCvodeAdams, kCvodeBdf: SUNDIALS CVODE on the same ODE in double, Adams
 //    with fixed-point iteration or BDF with Newton and a dense solver, roots
 //    for the events, re-initialised at every mode switch, stopping at every
@@ -18,10 +20,10 @@
 
 namespace vines::host::reference {
 
-enum class Method { kReference, kCvodeAdams, kCvodeBdf };
+enum class Method { kReference, kDop853, kCvodeAdams, kCvodeBdf };
 
 struct Options {
-  double rtol = 0;        // 0: method default (reference 1e-15, CVODE 1e-8)
+  double rtol = 0;        // 0: method default (reference 1e-15, DOP853 and CVODE 1e-8)
   double duration_s = 0;  // 0: all samples
 };
 
