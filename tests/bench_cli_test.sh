@@ -3,7 +3,7 @@
 # measured against data/reference: the El Centro Kuwabara scene must be within
 # 1e-6 of the reference peak with the reference's 18 contacts; the dop853
 # baseline alone; a bad option, an unknown baseline and a missing scene are
-# refused with a message.
+# refused with a message; CVODE baselines (below).
 set -euo pipefail
 vines="$1"
 src="$2"
@@ -45,4 +45,25 @@ if "$vines" bench /nonexistent.toml --json 2>/tmp/bench_cli_err.txt; then
   echo "bench_cli: a missing scene was accepted" >&2; exit 1
 fi
 grep -q "nonexistent.toml" /tmp/bench_cli_err.txt
+# CVODE baselines: lines of both methods in a build with SUNDIALS; in one
+# without (VINES_TEST_CVODE=0), refused (exit 1) saying how to get them.
+scene="$src/data/scenes/elcentro_vines.toml"
+if [[ ${VINES_TEST_CVODE:?} == 1 ]]; then
+  "$vines" bench "$scene" --json --min-time 0.05 --baselines 1e-6 --baseline-methods cvode-adams,cvode-bdf |
+    /usr/bin/python3 -c '
+import json, sys
+methods = sorted(l["method"] for l in json.load(sys.stdin)["lines"])
+assert methods == ["cvode-adams", "cvode-bdf", "firmware"], methods'
+else
+  for args in "--baselines 1e-6" "--baselines 1e-6 --baseline-methods cvode-bdf" ""; do
+    status=0
+    "$vines" bench "$scene" --min-time 0.05 $args >/dev/null 2>/tmp/bench_cli_err.txt || status=$?
+    if [[ $status != 1 ]]; then
+      echo "bench_cli: CVODE baselines ($args) in a build without CVODE: exit $status, not 1" >&2; exit 1
+    fi
+    grep -q "no CVODE.*libsundials-dev" /tmp/bench_cli_err.txt
+  done
+  "$vines" bench "$scene" --min-time 0.05 --no-baselines >/dev/null
+  "$vines" bench "$scene" --min-time 0.05 --baselines 1e-8 --baseline-methods dop853 >/dev/null
+fi
 echo "bench_cli: ok"

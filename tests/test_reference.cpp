@@ -1,7 +1,8 @@
 // The reference integrators (sim_host/reference): against closed forms, the
 // Hertz impact, their own convergence, the firmware loop, the stored
-// data/reference files, the CVODE baseline, and bad input. Suites named
-// *Slow run whole El Centro records (label "slow").
+// data/reference files, the CVODE baseline (or, built without it, its
+// refusal), and bad input. Suites named *Slow run whole El Centro records
+// (label "slow").
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -361,6 +362,7 @@ TEST(ReferenceSlow, Dop853BaselineConvergesToTheStoredReference) {
   EXPECT_EQ(tight.contacts, truth.contacts);
 }
 
+#ifdef VINES_HAVE_CVODE
 // CVODE at rtol 1e-8: the peak (reached at 5.57 s) to 1e-5. Contacts: the
 // motion is chaotic, so after ~40 s the trajectories part; compare the
 // contacts over the first 45 s, start by start.
@@ -381,5 +383,24 @@ TEST(ReferenceSlow, CvodeAgreesWithTheReference) {
       EXPECT_NEAR(e.contact_start_s[i], ref_early.contact_start_s[i], 0.05) << method_name(m) << " contact " << i;
   }
 }
+#else
+// A build without SUNDIALS: asking for CVODE is refused, saying how to get it
+// (and the reference and the DOP853 baseline still integrate).
+TEST(Reference, WithoutCvodeSaysHowToGetIt) {
+  const SceneParams p = test::paper_scene(DeviceKind::kVines);
+  const std::vector<double> a = {0.0, 1.0, 0.0};
+  for (Method m : {Method::kCvodeAdams, Method::kCvodeBdf}) {
+    try {
+      integrate(p, a, 50, m, {});
+      ADD_FAILURE() << method_name(m) << " ran in a build without CVODE";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("no CVODE"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("libsundials-dev"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(integrate(p, a, 50, Method::kReference, {}).steps, 0);
+  EXPECT_GT(integrate(p, a, 50, Method::kDop853, {}).steps, 0);
+}
+#endif
 
 }  // namespace

@@ -1,24 +1,46 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the project needs: host build and tests,
-# the Cortex-M4F and M7 cross builds, QEMU for the MCU images, and the plot script's
-# Python libraries. Installs only what is missing, so it is cheap to re-run.
+# Installs the Debian 12 packages of a set (default: all):
+#   main  what tools/main.sh needs: the compiler, CMake, the headers `vines`
+#         compiles against, TBB, and the plot script's Python libraries.
+#   all   main plus the tests and benchmarks, the CVODE baseline (SUNDIALS),
+#         MPI, the libFuzzer targets, the Cortex-M4F/M7 cross toolchain and
+#         QEMU for the MCU images (tools/test.sh, CI).
+# Installs only what is missing, so it is cheap to re-run.
 # Root or sudo; no questions asked (usable with no stdin, as in CI).
+# Usage: bash tools/setup.sh [main|all]
 set -euo pipefail
 
-packages=(
+main=(
   cmake make g++                                 # host build
-  libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
   libcli11-dev                                   # the vines command line
+  libtbb-dev                                     # the parallel map of sweep, design, stress
+  python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
+)
+rest=(
+  libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
+  libsundials-dev                                # CVODE baseline (vines bench, tests)
+  openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
+  clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
   qemu-system-arm                                # runs the MCU images (ctest)
-  python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
-  openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
-  libsundials-dev                                # CVODE baseline (vines reference, tests)
-  libtbb-dev                                     # the parallel map of sweep, design, stress
-  clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
 )
+
+if (($# > 1)); then
+  echo "usage: bash tools/setup.sh [main|all]" >&2
+  exit 2
+fi
+set_name=${1:-all}
+case $set_name in
+  main) packages=("${main[@]}") ;;
+  all) packages=("${main[@]}" "${rest[@]}") ;;
+  *)
+    echo "setup: unknown package set '$set_name' (main or all)" >&2
+    echo "usage: bash tools/setup.sh [main|all]" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
@@ -27,11 +49,11 @@ for p in "${packages[@]}"; do
     missing+=("$p")
 done
 if ((${#missing[@]} == 0)); then
-  echo "setup: all ${#packages[@]} packages are installed"
+  echo "setup: all ${#packages[@]} packages of set '$set_name' are installed"
   exit 0
 fi
 
-echo "setup: installing ${missing[*]}"
+echo "setup ($set_name): installing ${missing[*]}"
 sudo=()
 if [[ $(id -u) -ne 0 ]]; then sudo=(sudo); fi
 "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null

@@ -1,13 +1,16 @@
 // `vines bench SCENE.toml...`: speed against accuracy, against data/reference.
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/bench.hpp"
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/csv.hpp"
+#include "sim_host/reference/truth.hpp"
 #include "sim_host/scene.hpp"
 #include "vines/params.hpp"
 
@@ -44,6 +47,16 @@ int bench(BenchArgs a) {
   // The table has baselines by default; --json alone is the scene's own line.
   if (a.baselines->count() == 0 && !a.as_json) opt.baseline_rtols = {1e-6, 1e-8, 1e-10};
   if (a.no_baselines) opt.baseline_rtols.clear();
+  // Refused before any run: a table without the lines it was asked for is a silent wrong result.
+  const std::vector<std::string>& methods = opt.baseline_methods;
+  const bool cvode = methods.empty() || std::any_of(methods.begin(), methods.end(), [](const std::string& m) {
+                       return m.rfind("cvode", 0) == 0;
+                     });
+  if (!opt.baseline_rtols.empty() && cvode && *reference::cvode_missing())
+    throw std::runtime_error(std::string("the CVODE baselines (") +
+                             (methods.empty() ? "--baseline-methods default: all three" : "--baseline-methods") +
+                             "): " + reference::cvode_missing() +
+                             "; or leave them out with --baseline-methods dop853 or --no-baselines");
   std::vector<BenchLine> lines;
   for (const std::string& path : a.scenes) {
     const Scene scene = load_scene(path);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/engine.hpp"
 #include "sim_host/names.hpp"
 #include "sim_host/output.hpp"
 #include "sim_host/parallel.hpp"
@@ -47,6 +48,11 @@ void print_stress(const host::StressSummary& s, const host::StressRun& run,
               "%d thread%s\n",
               s.cases, static_cast<unsigned long long>(s.seed), s.refused, s.failed, s.degraded, s.wall_s,
               s.cases_per_s(), threads, threads > 1 ? "s" : "");
+  // The frames drawn from: those of this build (tools/main.sh builds the 10-story frame only).
+  const bool extra = compiled_frames(Scalar::kDouble, DeviceKind::kNone) != compiled_frames(Scalar::kDouble, DeviceKind::kTmd);
+  std::printf("frames: %s%s\n", compiled_story_counts().c_str(),
+              extra ? "" : "; no extra stress frames in this build: `cmake --preset release` and rebuild for the "
+                           "release preset's 1, 3, 10, 20 and 40 stories");
   std::printf("\n%-12s %6s %7s %12s %12s\n", "check", "runs", "failed", "worst", "bound");
   for (int c : checks_by_name()) {
     const CheckSummary& k = s.checks[static_cast<std::size_t>(c)];
@@ -133,7 +139,8 @@ void add_stress(CLI::App& vines) {
   auto a = std::make_shared<StressArgs>();
   host::StressOptions& opt = a->opt;
   CLI::App* cmd = add_command(vines, "stress",
-                              "Draw and run N random scenes (frames of 1-40 stories, every contact law, every "
+                              "Draw and run N random scenes (frames of the story counts this build has, 1-40 in the "
+                              "release preset; every contact law, every "
                               "record, PGA x0.05-20, 50 Hz-20 kHz) and check each: finite, energy balance, overlaps, "
                               "sub-step cap, loop guards, convergence at half the step.",
                               "Exit status 1 if any check fails, 130 if stopped by Ctrl-C.",

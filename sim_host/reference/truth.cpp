@@ -51,6 +51,15 @@ const char* method_name(Method m) {
   }
 }
 
+const char* cvode_missing() {
+#ifdef VINES_HAVE_CVODE
+  return "";
+#else
+  return "this build has no CVODE (SUNDIALS was not found when it was configured): install libsundials-dev "
+         "(bash tools/setup.sh all) and reconfigure (cmake --preset release), then rebuild";
+#endif
+}
+
 Result integrate(const SceneParams& p, const std::vector<double>& samples, double sample_rate_hz, Method m,
                  const Options& o) {
   const Ground g = check_ground(samples, sample_rate_hz, o.duration_s);
@@ -61,10 +70,16 @@ Result integrate(const SceneParams& p, const std::vector<double>& samples, doubl
     throw std::runtime_error(std::string("rtol ") + num(o.rtol) + " out of range for " + method_name(m) + ": [" +
                              num(lo) + ", " + num(kMaxRtol) + "]");
   const OdeSpec spec = make_spec(p);
+  const bool cvode = m == Method::kCvodeAdams || m == Method::kCvodeBdf;
+  if (cvode && *cvode_missing()) throw std::runtime_error(std::string(method_name(m)) + ": " + cvode_missing());
   const auto t0 = std::chrono::steady_clock::now();
+#ifdef VINES_HAVE_CVODE
   Result r = ref                    ? integrate_dop853<long double>(spec, g, rtol)
              : m == Method::kDop853 ? integrate_dop853<double>(spec, g, rtol)
                                     : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
+#else
+  Result r = ref ? integrate_dop853<long double>(spec, g, rtol) : integrate_dop853<double>(spec, g, rtol);
+#endif
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -44,4 +44,8 @@ Result integrate(const SceneParams& p, const std::vector<double>& samples, doubl
 
 const char* method_name(Method m);
 
+// Empty when this build has the CVODE baseline; else why not and how to get
+// it (integrate() throws it for the CVODE methods).
+const char* cvode_missing();
+
 }  // namespace vines::host::reference
