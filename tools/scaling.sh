@@ -17,10 +17,11 @@ if [[ -z $spec ]]; then
   # The IC grid alone: the ic_vines study of initial_conditions.toml, in a spec of its own.
   spec=data/studies/initial_conditions.toml
   /usr/bin/python3 - "$spec" "$tmp/ic_vines.toml" <<'EOF'
-import re, sys
+import os, re, sys
 text = open(sys.argv[1]).read()
 study = [s for s in re.split(r"(?m)^(?=\[\[study\]\])", text) if 'name = "ic_vines"' in s][0]
-open(sys.argv[2], "w").write(study.replace('scene = "../', 'scene = "%s/../' % sys.argv[1].rsplit("/", 1)[0]))
+folder = os.path.dirname(os.path.abspath(sys.argv[1]))
+open(sys.argv[2], "w").write(study.replace('scene = "../', 'scene = "%s/../' % folder))
 EOF
   spec=$tmp/ic_vines.toml
 fi
