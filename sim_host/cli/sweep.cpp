@@ -148,7 +148,7 @@ int sweep(SweepArgs a) {
     // Groups of a string key (a record folder): a line each.
     for (const GroupSummary& g : st.groups) {
       if (g.text.empty()) continue;
-      std::printf("    %-46s n=%-5zu", file_name(g.text).c_str(), g.x_r ? g.x_r->n : std::size_t{0});
+      std::printf("    %-56s n=%-5zu", file_name(g.text).c_str(), g.x_r ? g.x_r->n : std::size_t{0});
       if (g.x_r)
         std::printf(" x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", 100 * g.x_r->mean,
                     100 * g.x_r->sd, 100 * g.x_r->min, 100 * g.x_r->max, 100 * g.E_r->mean, 100 * g.E_r->sd);
