@@ -72,6 +72,11 @@ class Engine {
   virtual ~Engine() = default;
   // Builds the model; the parameters must fit this engine (see make_engine).
   virtual ParamError build(const SceneParams& p) = 0;
+  // Gives the built model the initial conditions of p (vines.initial_*,
+  // tmd.initial_*; vines::set_initial_conditions): the model is then, bit
+  // for bit, the one build(p) makes when p differs from the built parameters
+  // in nothing else. Call init() after it.
+  virtual ParamError set_initial_conditions(const SceneParams& p) = 0;
   // The model's image (vines/model_image.hpp), after build() or load_image().
   virtual std::vector<std::uint8_t> model_image() const = 0;
   // Loads a model image in place of building: empty on success, after which

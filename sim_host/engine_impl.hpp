@@ -19,6 +19,9 @@ template <typename S, int N, typename Dev>
 class EngineImpl final : public Engine {
  public:
   ParamError build(const SceneParams& p) override { return build_model(p, model_.get()); }
+  ParamError set_initial_conditions(const SceneParams& p) override {
+    return vines::set_initial_conditions(p.device, model_.get());
+  }
 
   std::vector<std::uint8_t> model_image() const override {
     std::vector<std::uint8_t> out(image::image_bytes<S, N, Dev>());

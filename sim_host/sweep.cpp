@@ -19,6 +19,7 @@
 #include "sim_host/output.hpp"
 #include "sim_host/parallel.hpp"
 #include "sim_host/run.hpp"
+#include "sim_host/scene_limits.hpp"
 #include "sim_host/scene_toml.hpp"
 #include "sim_host/sweep_log.hpp"
 #include "sim_host/status.hpp"
@@ -37,7 +38,10 @@ void set_key(toml::table& root, const KeyValue& v) {
   const std::string table = v.key.substr(0, dot), key = v.key.substr(dot + 1);
   toml::table* t = root[table].as_table();
   if (!t) t = root.insert_or_assign(table, toml::table{}).first->second.as_table();
-  if (v.text == "unset") t->erase(key);
+  if (v.record_file) {  // read as vines run --record reads it: its own format, units, column, time step
+    for (const char* k : {"format", "units", "dt_s", "column"}) t->erase(k);
+    t->insert_or_assign(key, v.text);
+  } else if (v.text == "unset") t->erase(key);
   else if (v.text == "true" || v.text == "false") t->insert_or_assign(key, v.text == "true");
   else if (!v.text.empty()) t->insert_or_assign(key, v.text);
   else if (v.integral) t->insert_or_assign(key, static_cast<int64_t>(std::llround(v.number)));
@@ -121,16 +125,50 @@ class Cache {
   // with a stop check between blocks (*info: the model, when asked for).
   static RunTotals run_totals(const Scene& s, SceneParams p, const Excitation& ex, const std::atomic<bool>* stop,
                               ModelInfo* info = nullptr) {
-    constexpr std::size_t kBlock = 512;
     p.loop.floor_peaks = false;
     std::unique_ptr<Engine> e = build(s, p);
     if (info) *info = e->info();
-    e->init(ex.samples[0]);
+    return run_engine(*e, ex, stop);
+  }
+  static RunTotals run_engine(Engine& e, const Excitation& ex, const std::atomic<bool>* stop) {
+    constexpr std::size_t kBlock = 512;
+    e.init(ex.samples[0]);
     for (std::size_t k = 1; k < ex.samples.size(); k += kBlock) {
       stop_point(stop);
-      e->run(ex.samples.data() + k, std::min(kBlock, ex.samples.size() - k));
+      e.run(ex.samples.data() + k, std::min(kBlock, ex.samples.size() - k));
     }
-    return e->totals();
+    return e.totals();
+  }
+
+  // A run's scene less its initial conditions, and what its runs share: the
+  // excitation, the bare frame, the gap (when asked for), the parameters as
+  // built (Kuwabara tau calibrated) and the key of the model they build.
+  struct Base {
+    RunScene run;
+    SceneParams params;
+    std::string model_key;
+    std::shared_ptr<const Excitation> excitation;
+    std::shared_ptr<const RunTotals> bare;
+    double gap = 0;
+  };
+  // `key` names the study and `values` (no initial conditions, none scaled).
+  std::shared_ptr<const Base> base(const std::string& key, const toml::table& table, const std::string& origin,
+                                   const std::vector<KeyValue>& values, bool need_gap) {
+    return get<Base>(bases_, key + (need_gap ? "|gap" : ""), [&] {
+      Base b{scene_with(table, origin, values), {}, {}, {}, {}, 0};
+      b.params = b.run.scene.params;
+      if (b.params.device.kind == DeviceKind::kVines && b.params.device.vines.law == ContactLaw::kKuwabara &&
+          b.params.device.vines.tau_s == 0.0)
+        b.params.device.vines.tau_s = tau(b.run);
+      // The model: every table but the record's, less the initial conditions.
+      b.model_key = key_of(scalar_name(b.run.scene.scalar), b.run.table, {"frame", "device", "tmd", "vines", "loop"},
+                           {"vines.initial_position_m", "vines.initial_velocity_mps", "tmd.initial_position_m",
+                            "tmd.initial_velocity_mps"});
+      b.excitation = excitation(b.run);
+      b.bare = bare(b.run);
+      if (need_gap) b.gap = gap(b.run);
+      return b;
+    });
   }
 
  private:
@@ -176,52 +214,183 @@ class Cache {
   Map<Excitation> excitations_;
   Map<RunTotals> bares_;
   Map<double> taus_, gaps_;
+  Map<Base> bases_;
 };
+
+// Built engines between runs: a worker takes one of the model it needs (or
+// builds it) and gives it back after its run; runs that differ only in
+// initial conditions or in the record reuse it (Engine::set_initial_conditions)
+// instead of building the model again. At most kHeld engines are kept.
+class EnginePool {
+ public:
+  std::unique_ptr<Engine> take(const std::string& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = idle_.find(key);
+    if (it == idle_.end() || it->second.empty()) return nullptr;
+    std::unique_ptr<Engine> e = std::move(it->second.back());
+    it->second.pop_back();
+    --held_;
+    return e;
+  }
+  void give(const std::string& key, std::unique_ptr<Engine> e) {
+    constexpr std::size_t kHeld = 64;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (held_ >= kHeld) {  // many models (a grid over the design): start afresh
+      idle_.clear();
+      held_ = 0;
+    }
+    idle_[key].push_back(std::move(e));
+    ++held_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::vector<std::unique_ptr<Engine>>> idle_;
+  std::size_t held_ = 0;
+};
+
+// Keys that only say where the device starts: runs that differ in nothing
+// else share a built model.
+bool initial_condition_key(const std::string& key) {
+  return key == "vines.initial_position_m" || key == "vines.initial_velocity_mps" ||
+         key == "tmd.initial_position_m" || key == "tmd.initial_velocity_mps";
+}
+
+// Sets an initial condition in the parameters, as the scene reader does.
+void set_initial_condition(SceneParams* p, const std::string& key, double x) {
+  if (key == "vines.initial_position_m") {
+    p->device.vines.initial_position_m = x;
+    p->device.vines.start_at_left_wall = false;
+  } else if (key == "vines.initial_velocity_mps") {
+    p->device.vines.initial_velocity_mps = x;
+  } else if (key == "tmd.initial_position_m") {
+    p->device.tmd.initial_position_m = x;
+  } else {
+    p->device.tmd.initial_velocity_mps = x;
+  }
+}
+
+// A run's figures from its totals and its bare frame's.
+RunResult result_of(const RunTotals& t, const RunTotals& b, const SceneParams& p, const ModelInfo& info,
+                    Scalar scalar) {
+  RunResult r;
+  r.device = p.device.kind == DeviceKind::kTmd ? "tmd" : p.device.kind == DeviceKind::kVines ? "vines" : "none";
+  r.peak_top = t.peak_top;
+  r.elastic_energy = t.elastic_energy;
+  r.x_r = reduction(b.peak_top, t.peak_top);
+  r.E_r = reduction(b.elastic_energy, t.elastic_energy);
+  r.residual = t.ledger.relative_residual();
+  r.contacts = t.count.contacts;
+  // The guards of both runs, and the status (a device run is compared with its bare frame).
+  const bool device = p.device.kind != DeviceKind::kNone;
+  r.cap_hits = t.count.cap_hits;
+  r.bad_samples = t.count.bad_samples + (device ? b.count.bad_samples : 0);
+  r.divergences = t.count.divergences + (device ? b.count.divergences : 0);
+  r.max_overlap = t.max_overlap;
+  r.energy_checked = p.loop.energy_ledger;
+  const RunStatus status = device_status(t, device ? &b : nullptr, p, info, scalar);
+  r.degraded = !status.ok();
+  r.degraded_reasons = status.codes();
+  return r;
+}
+
+// Any run: its scene from the study's table with every key set (TOML), a
+// model built for it.
+RunResult run_general(const StudySpec& st, const RunPlan& plan, const toml::table& base, Cache& cache,
+                      const std::atomic<bool>* stop) {
+  // Literal values first; scaled ones need the design (gap) and the bare run (vmax).
+  std::vector<KeyValue> values = st.set, scaled;
+  for (const KeyValue& v : plan.values) (v.scaled() ? scaled : values).push_back(v);
+  RunScene run = scene_with(base, st.scene_path, values);
+  if (!scaled.empty()) {
+    for (KeyValue v : scaled) {
+      const std::string what = v.text.substr(6);
+      v.number *= what == "gap" ? cache.gap(run) : cache.bare(run)->peak_top_velocity;
+      v.text.clear();
+      values.push_back(v);
+    }
+    run = scene_with(base, st.scene_path, values);
+  }
+  SceneParams p = run.scene.params;
+  if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
+      p.device.vines.tau_s == 0.0)
+    p.device.vines.tau_s = cache.tau(run);
+  ModelInfo info;
+  const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop, &info);
+  return result_of(t, *cache.bare(run), p, info, run.scene.scalar);
+}
+
+// A run whose initial conditions are numbers and whose other keys are not
+// scaled: the scene less its initial conditions is shared (one TOML pass per
+// distinct set of other keys), the initial conditions go into the parameters,
+// the model comes from the pool. nullopt when the parameters are refused:
+// run_general then says why, in the scene's words.
+std::optional<RunResult> run_shared(int study, const StudySpec& st, const RunPlan& plan, const toml::table& table,
+                                    Cache& cache, EnginePool& pool, const std::atomic<bool>* stop) {
+  std::vector<KeyValue> others, initial;
+  std::string key = std::to_string(study);
+  bool need_gap = false;
+  for (const std::vector<KeyValue>* list : {&st.set, &plan.values})
+    for (const KeyValue& v : *list) {
+      if (initial_condition_key(v.key) && (v.text.empty() || v.scaled())) {
+        initial.push_back(v);
+        need_gap |= v.text == "scale:gap";
+      } else if (v.scaled()) {
+        return run_general(st, plan, table, cache, stop);
+      } else {
+        others.push_back(v);
+        key += '|' + v.key + '=' + (v.text.empty() ? v.label() : (v.record_file ? "file:\"" : "\"") + v.text + '"');
+      }
+    }
+  std::shared_ptr<const Cache::Base> b;
+  try {
+    b = cache.base(key, table, st.scene_path, others, need_gap);
+  } catch (const std::exception&) {
+    return std::nullopt;  // refused: in the words of the whole scene
+  }
+  // The scene's parameters (as read, and as built) with the initial conditions set.
+  SceneParams read = b->run.scene.params, p = b->params;
+  for (const KeyValue& v : initial) {
+    const double scale = v.text == "scale:gap" ? b->gap : v.text == "scale:vmax" ? b->bare->peak_top_velocity : 1.0;
+    set_initial_condition(&read, v.key, v.number * scale);
+    set_initial_condition(&p, v.key, v.number * scale);
+  }
+  // The checks the scene reader makes of these keys; the contact scales read
+  // the initial speed only through this speed (scene_limits.cpp), checked
+  // already for the scene when it is the same.
+  auto speed = [](const SceneParams& q) {
+    const VinesParams& v = q.device.vines;
+    return std::max({v.v_ref_mps, std::fabs(v.initial_velocity_mps), kMinRepresentativeSpeed});
+  };
+  if (!validate(read).ok() || (speed(read) != speed(b->run.scene.params) && check_contact_scales(read)))
+    return std::nullopt;
+  std::unique_ptr<Engine> e = pool.take(b->model_key);
+  if (e && !e->set_initial_conditions(p).ok()) {
+    pool.give(b->model_key, std::move(e));
+    return std::nullopt;
+  }
+  if (!e) {
+    SceneParams built = p;
+    built.loop.floor_peaks = false;
+    e = make_engine(built, b->run.scene.scalar);
+    if (!e || !e->build(built).ok()) return std::nullopt;
+  }
+  const ModelInfo info = e->info();
+  const RunTotals t = Cache::run_engine(*e, *b->excitation, stop);
+  pool.give(b->model_key, std::move(e));
+  return result_of(t, *b->bare, p, info, b->run.scene.scalar);
+}
 
 // A run, or Stopped once *stop is set.
 RunResult run_one(const SweepSpec& spec, const RunPlan& plan, const std::vector<toml::table>& bases,
-                  Cache& cache, const std::atomic<bool>* stop) {
+                  Cache& cache, EnginePool& pool, const std::atomic<bool>* stop) {
   const StudySpec& st = spec.studies[plan.study];
   RunResult r;
   try {
-    // Literal values first; scaled ones need the design (gap) and the bare run (vmax).
-    std::vector<KeyValue> values = st.set, scaled;
-    for (const KeyValue& v : plan.values) (v.scaled() ? scaled : values).push_back(v);
-    RunScene run = scene_with(bases[plan.study], st.scene_path, values);
-    if (!scaled.empty()) {
-      for (KeyValue v : scaled) {
-        const std::string what = v.text.substr(6);
-        v.number *= what == "gap" ? cache.gap(run) : cache.bare(run)->peak_top_velocity;
-        v.text.clear();
-        values.push_back(v);
-      }
-      run = scene_with(bases[plan.study], st.scene_path, values);
-    }
-    SceneParams p = run.scene.params;
-    r.device = p.device.kind == DeviceKind::kTmd ? "tmd" : p.device.kind == DeviceKind::kVines ? "vines" : "none";
-    if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
-        p.device.vines.tau_s == 0.0)
-      p.device.vines.tau_s = cache.tau(run);
-    ModelInfo info;
-    const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop, &info);
-    const RunTotals& b = *cache.bare(run);
-    r.peak_top = t.peak_top;
-    r.elastic_energy = t.elastic_energy;
-    r.x_r = reduction(b.peak_top, t.peak_top);
-    r.E_r = reduction(b.elastic_energy, t.elastic_energy);
-    r.residual = t.ledger.relative_residual();
-    r.contacts = t.count.contacts;
-    // The guards of both runs, and the status (a device run is compared with its bare frame).
-    const bool device = p.device.kind != DeviceKind::kNone;
-    r.cap_hits = t.count.cap_hits;
-    r.bad_samples = t.count.bad_samples + (device ? b.count.bad_samples : 0);
-    r.divergences = t.count.divergences + (device ? b.count.divergences : 0);
-    r.max_overlap = t.max_overlap;
-    r.energy_checked = p.loop.energy_ledger;
-    const RunStatus status = device_status(t, device ? &b : nullptr, p, info, run.scene.scalar);
-    r.degraded = !status.ok();
-    r.degraded_reasons = status.codes();
+    std::optional<RunResult> shared = run_shared(plan.study, st, plan, bases[plan.study], cache, pool, stop);
+    r = shared ? *shared : run_general(st, plan, bases[plan.study], cache, stop);
   } catch (const std::exception& e) {
+    r = RunResult{};
     r.error = e.what();
   }
   r.done = true;
@@ -266,7 +435,8 @@ StudySummary summarize_study(const SweepSpec& spec, int s, const std::vector<Run
     }
   };
   Figures all;
-  std::map<double, Figures> groups;
+  // By value: numbers in order, strings (record files) by name.
+  std::map<std::pair<double, std::string>, Figures> groups;
   const std::string gkey = !st.group_by.empty() ? st.group_by
                            : (!st.optimize.empty() && st.grid_axes.size() == 1) ? st.grid_axes[0].front().key
                                                                                   : "";
@@ -276,7 +446,7 @@ StudySummary summarize_study(const SweepSpec& spec, int s, const std::vector<Run
     out.device = results[i].device;
     out.energy_checked &= results[i].energy_checked;
     for (const KeyValue& v : plan[i].values)
-      if (v.key == gkey) groups[v.number].add(results[i]);
+      if (v.key == gkey) groups[{v.text.empty() ? v.number : 0.0, v.text}].add(results[i]);
   }
   out.runs = all.xr.size() + all.degraded;
   out.degraded = all.degraded;
@@ -287,11 +457,12 @@ StudySummary summarize_study(const SweepSpec& spec, int s, const std::vector<Run
   out.best = -1e300;
   // The best group: of the best mean over its ok runs.
   for (auto& [value, g] : groups) {
-    out.groups.push_back({value, stats(g.xr), stats(g.er), g.degraded});
+    out.groups.push_back({value.first, value.second, stats(g.xr), stats(g.er), g.degraded});
     const std::optional<Stats>& m = st.optimize == "E_r" ? out.groups.back().E_r : out.groups.back().x_r;
     if (m && m->mean > out.best) {
       out.best = m->mean;
-      out.best_value = value;
+      out.best_value = value.first;
+      out.best_text = value.second;
     }
   }
   return out;
@@ -352,17 +523,21 @@ json SweepSummary::to_json() const {
     if (!st.groups.empty()) {
       json jg = json::array();
       for (const GroupSummary& g : st.groups)
-        jg.push_back({{"value", g.value}, {"x_r", stats_json(g.x_r)}, {"E_r", stats_json(g.E_r)},
-                      {"degraded", g.degraded}});
+        jg.push_back({{"value", g.text.empty() ? json(g.value) : json(g.text)}, {"x_r", stats_json(g.x_r)},
+                      {"E_r", stats_json(g.E_r)}, {"degraded", g.degraded}});
       j["group_by"] = st.group_by;
       j["groups"] = jg;
-      if (!st.optimize.empty()) j["best"] = {{"key", st.group_by}, {"value", st.best_value}, {st.optimize, st.best}};
+      if (!st.optimize.empty())
+        j["best"] = {{"key", st.group_by},
+                     {"value", st.best_text.empty() ? json(st.best_value) : json(st.best_text)},
+                     {st.optimize, st.best}};
     }
     js.push_back(j);
   }
   return {{"spec", spec},   {"runs", runs},           {"done", done},
           {"failed", failed}, {"complete", done == runs}, {"wall_time_s", wall_s},
-          {"runs_per_s", runs_per_s()}, {"studies", js}, {"degraded", degraded}};
+          {"runs_per_s", runs_per_s()}, {"cores", cores}, {"runs_per_s_per_core", runs_per_s_per_core()},
+          {"studies", js}, {"degraded", degraded}};
 }
 
 std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>& plan, int threads,
@@ -376,15 +551,17 @@ std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>
   for (std::size_t i = static_cast<std::size_t>(offset); i < plan.size(); i += static_cast<std::size_t>(stride))
     if (!results[i].done) mine.push_back(i);
   Cache cache(stop);
+  EnginePool pool;
   parallel_map(mine.size(), MapOptions{threads, stop, progress, "sweep", "runs"}, [&](std::size_t k) {
-    results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache, stop);
+    results[mine[k]] = run_one(spec, plan[mine[k]], bases, cache, pool, stop);
     if (log != nullptr) log->append(mine[k], results[mine[k]]);
   });
   return results;
 }
 
 SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
-                         const std::vector<RunResult>& results, const std::string& out_dir, double wall_s) {
+                         const std::vector<RunResult>& results, const std::string& out_dir, double wall_s,
+                         int cores) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create: " + ec.message());
@@ -393,6 +570,7 @@ SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan
   s.spec = spec.path;
   s.runs = plan.size();
   s.wall_s = wall_s;
+  s.cores = cores;
   for (const RunResult& r : results) {
     s.done += r.done;
     s.failed += r.done && !r.error.empty();

@@ -13,7 +13,10 @@
 //                 or a list of such tables (their union); scale = "gap" (the
 //                 VI NES free travel) or "vmax" (the bare frame's peak top
 //                 velocity) multiplies the values; a value "unset" removes
-//                 the key from the scene.
+//                 the key from the scene; "record.path" also takes
+//                 { folder = "DIR", glob = "*.at2" }: every file of DIR
+//                 (relative to the spec) matching glob, sorted, each read
+//                 with its own format and units (as vines run --record).
 // Runs are the product cases x grid; each is the scene with its keys set. A
 // run's x_r and E_r compare it with the bare frame on the same record.
 #pragma once
@@ -42,6 +45,9 @@ struct KeyValue {
   double number = 0;
   bool integral = false;
   std::string text;  // a string value ("unset" removes the key), or "scale:gap"/"scale:vmax"
+  // A file of a record folder (record.path only): read as `vines run --record`
+  // reads it, its own format, units, column and time step.
+  bool record_file = false;
   std::string label() const;   // the value as written in results.csv
   std::string column() const;  // its results.csv column: the key, "/gap" or "/vmax" when scaled
   bool scaled() const { return text.rfind("scale:", 0) == 0; }
@@ -120,7 +126,8 @@ struct Stats {
 
 // The runs of a study with one value of its group key.
 struct GroupSummary {
-  double value = 0;
+  double value = 0;      // the key's value, when a number
+  std::string text;      // the key's value, when a string (a record file)
   std::optional<Stats> x_r, E_r;  // none when every run of the group is degraded
   std::size_t degraded = 0;
 };
@@ -135,6 +142,7 @@ struct StudySummary {
   std::vector<GroupSummary> groups;     // by value
   std::string optimize;                 // "", "x_r" or "E_r"
   double best_value = 0, best = 0;      // the group of the best mean (with optimize)
+  std::string best_text;                // its value when a string
 };
 
 // summary.json of a sweep.
@@ -142,14 +150,17 @@ struct SweepSummary {
   std::string spec;
   std::size_t runs = 0, done = 0, failed = 0, degraded = 0;
   double wall_s = 0;
+  int cores = 1;  // threads used, over every rank
   std::vector<StudySummary> studies;
   double runs_per_s() const { return wall_s > 0 ? done / wall_s : 0.0; }
+  double runs_per_s_per_core() const { return runs_per_s() / cores; }
   nlohmann::json to_json() const;
 };
 
 // results.csv and summary.json of a (possibly partial) result set in
-// out_dir; returns the summary.
+// out_dir, run in wall_s on `cores` threads (over every rank); returns the summary.
 SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
-                         const std::vector<RunResult>& results, const std::string& out_dir, double wall_s);
+                         const std::vector<RunResult>& results, const std::string& out_dir, double wall_s,
+                         int cores = 1);
 
 }  // namespace vines::host

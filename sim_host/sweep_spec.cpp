@@ -1,5 +1,6 @@
 // `vines sweep` specs: the [[study]] tables of a spec file, checked, and the
 // runs they make (format at the top of sweep.hpp).
+#include <fnmatch.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "host/record.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/sweep.hpp"
 
@@ -143,6 +145,54 @@ Scaled grid_axis(const std::string& where, const std::string& key, const toml::n
   return ax;
 }
 
+// The files of a record folder { folder = "DIR", glob = "PATTERN" } (DIR
+// relative to the spec's folder), sorted by name, each checked readable as a
+// record: an unreadable file, a missing folder or no match is refused.
+std::vector<KeyValue> folder_axis(const std::string& where, const std::string& key, const toml::table& t,
+                                  const fs::path& spec_dir) {
+  for (auto&& kv : t)
+    if (kv.first != "folder" && kv.first != "glob")
+      fail(where, key + ": unknown record folder key '" + std::string(kv.first.str()) + "' (known: folder, glob)");
+  if (key != "record.path") fail(where, key + ": a folder gives values of record.path only");
+  const auto folder = t["folder"].value<std::string>();
+  const std::string glob = t["glob"].value_or(std::string("*"));
+  if (!folder || folder->empty()) fail(where, key + ": folder must be a folder name");
+  const fs::path dir = fs::absolute(spec_dir / *folder).lexically_normal();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    fail(where, key + ": folder '" + *folder + "' (" + dir.string() + "): not a folder");
+  std::vector<std::string> files;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (fnmatch(glob.c_str(), name.c_str(), FNM_PERIOD) == 0 && e.is_regular_file(ec)) files.push_back(e.path());
+  }
+  if (ec) fail(where, key + ": folder '" + dir.string() + "': cannot list: " + ec.message());
+  if (files.empty()) fail(where, key + ": no file in folder '" + dir.string() + "' matches glob '" + glob + "'");
+  std::sort(files.begin(), files.end());
+  std::vector<KeyValue> out;
+  for (const std::string& f : files) {
+    // Read now, as a run will (vines run --record): a file that cannot be read is refused, not skipped.
+    hal::RecordSpec rs;
+    rs.path = f;
+    std::string why;
+    try {
+      if (hal::detect_record_format(f) == hal::RecordFormat::kAccel) why = "one column of values and no time step";
+      else hal::load_record(rs);
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    if (!why.empty())
+      fail(where, key + ": " + f + ": cannot be read as a record file: " + why +
+                      " (choose a glob that leaves it out)");
+    KeyValue v;
+    v.key = key;
+    v.text = f;
+    v.record_file = true;
+    out.push_back(v);
+  }
+  return out;
+}
+
 void check_keys(const std::string& where, const toml::table& t,
                 std::initializer_list<std::string_view> known) {
   for (auto&& kv : t)
@@ -222,7 +272,12 @@ SweepSpec load_sweep(const std::string& path) {
     }
     if (auto g = t->at_path("grid").as_table())
       for (auto&& kv : *g) {
-        Scaled ax = grid_axis(where, std::string(kv.first.str()), kv.second);
+        const std::string key(kv.first.str());
+        if (const toml::table* f = kv.second.as_table(); f && f->contains("folder")) {
+          st.grid_axes.push_back(folder_axis(where, key, *f, fs::path(path).parent_path()));
+          continue;
+        }
+        Scaled ax = grid_axis(where, key, kv.second);
         if (!ax.scale.empty())
           for (KeyValue& v : ax.values) v.text = "scale:" + ax.scale;
         st.grid_axes.push_back(ax.values);

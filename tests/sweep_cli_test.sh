@@ -22,6 +22,25 @@ if [[ "${VINES_TEST_MPI:-0}" == 1 ]]; then
   echo "mpi: 3 ranks give the threaded result set"
 fi
 
+# A record folder as a grid key (data/studies/record_folder.toml on a 2 x 2
+# grid): the same results.csv from 1 and 2 threads and from 3 MPI ranks.
+gm=${VINES_GROUND_MOTIONS:-$src/../shared/data/ground_motions}
+if [[ -d $gm ]]; then
+  sed -e "s|folder = \"[^\"]*\"|folder = \"$(cd "$gm" && pwd)\"|" -e "s|count = 5|count = 2|" \
+      -e "s|scene = \"../|scene = \"$src/data/|" "$src/data/studies/record_folder.toml" > "$tmp/records.toml"
+  "$vines" sweep "$tmp/records.toml" --threads 2 --out "$tmp/rec2" --no-progress
+  "$vines" sweep "$tmp/records.toml" --threads 1 --out "$tmp/rec1" --no-progress
+  cmp "$tmp/rec2/results.csv" "$tmp/rec1/results.csv"
+  grep -q '"group_by": "record.path"' "$tmp/rec2/summary.json"
+  if [[ "${VINES_TEST_MPI:-0}" == 1 ]]; then
+    mpirun -n 3 "$vines" sweep "$tmp/records.toml" --threads 1 --out "$tmp/recmpi" --no-progress
+    cmp "$tmp/rec2/results.csv" "$tmp/recmpi/results.csv"
+  fi
+  echo "record folder: $(($(wc -l < "$tmp/rec2/results.csv") - 1)) runs, the same results.csv on threads and ranks"
+else
+  echo "record folder: $gm not found, not checked"
+fi
+
 # Ctrl-C: a long sweep stopped early exits 130 and keeps what finished.
 "$vines" sweep "$src/data/studies/initial_conditions.toml" --threads 2 --out "$tmp/int" --no-progress &
 pid=$!

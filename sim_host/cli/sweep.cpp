@@ -32,6 +32,9 @@ struct SweepArgs {
   bool accept_degraded = false;
 };
 
+// A group value as printed: a file by its name.
+std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
 std::string duration_text(double s) {
   char t[32];
   if (s < 120) std::snprintf(t, sizeof t, "%.0f s", s);
@@ -119,15 +122,15 @@ int sweep(SweepArgs a) {
   mpi.gather(&results);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (mpi.rank() != 0) return kOk;
-  const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall);
+  const int cores = map_threads(opt.threads) * mpi.size();
+  const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall, cores);
   out.finish({"results.csv", "summary.json", "runs.jsonl"});
   // The rate of the runs run now (a resumed sweep read the others from its log).
   const std::size_t ran = s.done - resumed;
   const std::string from_log = resumed > 0 ? " (" + std::to_string(resumed) + " from the log)" : "";
-  std::printf("sweep %s: %zu of %zu runs%s in %.2f s (%.1f runs/s, %d rank%s), %zu failed, %zu degraded; results "
-              "in %s/\n",
-              a.spec_path.c_str(), s.done, plan.size(), from_log.c_str(), wall, wall > 0 ? ran / wall : 0.0,
-              mpi.size(), mpi.size() > 1 ? "s" : "", s.failed, s.degraded, opt.out_dir.c_str());
+  std::printf("sweep %s: %zu of %zu runs%s in %.2f s, %zu failed, %zu degraded; results in %s/\n",
+              a.spec_path.c_str(), s.done, plan.size(), from_log.c_str(), wall, s.failed, s.degraded,
+              opt.out_dir.c_str());
   // A line per study that has results: x_r and E_r over its ok runs, the best value, the degraded runs.
   for (const StudySummary& st : s.studies) {
     if (st.runs == 0) continue;
@@ -135,11 +138,28 @@ int sweep(SweepArgs a) {
     if (st.x_r)
       std::printf(" x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", 100 * st.x_r->mean,
                   100 * st.x_r->sd, 100 * st.x_r->min, 100 * st.x_r->max, 100 * st.E_r->mean, 100 * st.E_r->sd);
-    if (!st.optimize.empty() && !st.groups.empty()) std::printf("  best %s = %g", st.group_by.c_str(), st.best_value);
+    if (!st.optimize.empty() && !st.groups.empty()) {
+      if (st.best_text.empty()) std::printf("  best %s = %g", st.group_by.c_str(), st.best_value);
+      else std::printf("  best %s = %s", st.group_by.c_str(), file_name(st.best_text).c_str());
+    }
     if (st.degraded > 0) std::printf("  (%zu degraded, not counted)", st.degraded);
     if (!st.energy_checked) std::printf("  (energy balance not computed)");
     std::printf("\n");
+    // Groups of a string key (a record folder): a line each.
+    for (const GroupSummary& g : st.groups) {
+      if (g.text.empty()) continue;
+      std::printf("    %-56s n=%-5zu", file_name(g.text).c_str(), g.x_r ? g.x_r->n : std::size_t{0});
+      if (g.x_r)
+        std::printf(" x_r %6.2f %% +- %5.2f [%6.2f, %6.2f]  E_r %6.2f %% +- %5.2f", 100 * g.x_r->mean,
+                    100 * g.x_r->sd, 100 * g.x_r->min, 100 * g.x_r->max, 100 * g.E_r->mean, 100 * g.E_r->sd);
+      if (g.degraded > 0) std::printf("  (%zu degraded, not counted)", g.degraded);
+      std::printf("\n");
+    }
   }
+  const double rate = wall > 0 ? static_cast<double>(ran) / wall : 0.0;
+  std::printf("  %.1f runs/s, %.1f runs/s per core (%d core%s: %d rank%s x %d thread%s)\n", rate, rate / cores, cores,
+              cores > 1 ? "s" : "", mpi.size(), mpi.size() > 1 ? "s" : "", cores / mpi.size(),
+              cores / mpi.size() > 1 ? "s" : "");
   if (*stop) {
     std::fprintf(stderr,
                  "vines sweep: stopped (Ctrl-C): %s/results.csv and summary.json hold the %zu finished of %zu runs "

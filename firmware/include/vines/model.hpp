@@ -160,6 +160,44 @@ struct Model {
   }
 };
 
+// Sets the device's initial conditions (TMD: x0, v0; VI NES: where the
+// particle starts, its speed, and the wall coordinates and tolerances that
+// follow from where it starts) in a model built from the same parameters
+// otherwise: the model is then the one build_model makes from `dev`, bit for
+// bit (build_model ends with this call). Finiteness is validate()'s; returns
+// the first problem found. Needs only the device design and md.loop, so a
+// model loaded from an image can take new initial conditions too.
+template <typename S, int N, typename Dev>
+ParamError set_initial_conditions(const DeviceParams& dev, Model<S, N, Dev>* out) {
+  Model<S, N, Dev>& md = *out;
+  if constexpr (Dev::kKind == DeviceKind::kTmd) {
+    md.dev.x0 = static_cast<S>(dev.tmd.initial_position_m);
+    md.dev.v0 = static_cast<S>(dev.tmd.initial_velocity_mps);
+  }
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    const VinesParams& vp = dev.vines;
+    auto& dm = md.dev;
+    const double gap = dm.design.gap;
+    const double y0 = vp.start_at_left_wall ? -gap : vp.initial_position_m;
+    if (std::fabs(y0) > gap) return {"vines.initial_position_m", "must lie within the free travel (-gap, +gap)"};
+    // The particle is carried as s = y - y0, its displacement (relative to the
+    // ground) from where it starts; the walls are at r = s - x_floor equal to
+    // -gap - y0 and gap - y0. Starting on the left wall, that wall is at 0
+    // exactly: no cancellation fakes sub-nanometre contacts.
+    dm.wall_left = static_cast<S>(-gap - y0);
+    dm.wall_right = static_cast<S>(gap - y0);
+    dm.y0 = static_cast<S>(y0);
+    dm.v0 = static_cast<S>(vp.initial_velocity_mps);
+    constexpr S kEps = std::numeric_limits<S>::epsilon();
+    const S rtol = std::fmax(static_cast<S>(md.loop.contact_rtol), S(64) * kEps);
+    dm.event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2), S(64) * kEps * (dm.wall_right - dm.wall_left));
+    dm.round_tol = S(16) * kEps * (dm.wall_right - dm.wall_left);
+    dm.clear_lo = dm.wall_left - dm.event_tol;
+    dm.clear_hi = dm.wall_right + dm.event_tol;
+  }
+  return {};
+}
+
 #if VINES_MODEL_REPORT
 namespace detail {
 
@@ -249,8 +287,6 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     const TmdDesign t = design_tmd(p.device.tmd, device_mass, md.nominal_modal.m_eff(0),
                                    md.nominal_modal.omega(0));
     md.dev.design = t;
-    md.dev.x0 = static_cast<S>(p.device.tmd.initial_position_m);
-    md.dev.v0 = static_cast<S>(p.device.tmd.initial_velocity_mps);
     const int f = md.floor, d = N;
     ph.m(d, d) = t.mass;
     ph.k_device(f, f) = ph.k_device(d, d) = t.k;
@@ -335,22 +371,11 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     const VinesDesign d = design_vines(vp, device_mass, floor_mass);
     if (!d.ok) return {"vines.eps", "tau could not be calibrated for this eps and v_ref"};
     if (!(d.gap > 0.0)) return {"vines.box_length_m", "must be longer than the sphere diameter"};
-    const double y0 = vp.start_at_left_wall ? -d.gap : vp.initial_position_m;
-    if (std::fabs(y0) > d.gap)
-      return {"vines.initial_position_m", "must lie within the free travel (-gap, +gap)"};
     auto& dm = md.dev;
     dm.design = d;
     dm.m = static_cast<S>(d.mass);
     dm.inv_m = static_cast<S>(1.0 / d.mass);
     dm.m_star = static_cast<S>(d.m_star);
-    // The particle is carried as s = y - y0, its displacement (relative to the
-    // ground) from where it starts; the walls are at r = s - x_floor equal to
-    // -gap - y0 and gap - y0. Starting on the left wall, that wall is at 0
-    // exactly: no cancellation fakes sub-nanometre contacts.
-    dm.wall_left = static_cast<S>(-d.gap - y0);
-    dm.wall_right = static_cast<S>(d.gap - y0);
-    dm.y0 = static_cast<S>(y0);
-    dm.v0 = static_cast<S>(vp.initial_velocity_mps);
     dm.c = static_cast<S>(d.c);
     dm.eps = static_cast<S>(d.eps);
     dm.law = LawOf<Dev::kLaw>::template kernel<S>(d);
@@ -365,14 +390,8 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
     dm.w_step0 = static_cast<S>(0.02 * std::pow(static_cast<double>(dm.pos_scale), 0.25) / v_scale);
     const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
     dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));
-    constexpr S kEps = std::numeric_limits<S>::epsilon();
-    const S rtol = std::fmax(static_cast<S>(p.loop.contact_rtol), S(64) * kEps);
-    dm.event_tol = std::fmax(rtol * dm.pos_scale * S(1e-2), S(64) * kEps * (dm.wall_right - dm.wall_left));
-    dm.round_tol = S(16) * kEps * (dm.wall_right - dm.wall_left);
-    dm.clear_lo = dm.wall_left - dm.event_tol;
-    dm.clear_hi = dm.wall_right + dm.event_tol;
   }
-  return {};
+  return set_initial_conditions(p.device, out);
 }
 
 #endif  // VINES_MODEL_REPORT
