@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <future>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -62,11 +63,16 @@ RunScene scene_with(const toml::table& base, const std::string& origin, const st
   return r;
 }
 
+// Keys that only say where the device starts: runs that differ in nothing
+// else share a built model.
+constexpr std::string_view kInitialConditionKeys[] = {"vines.initial_position_m", "vines.initial_velocity_mps",
+                                                      "tmd.initial_position_m", "tmd.initial_velocity_mps"};
+
 // A cache key: the named tables of a run's scene as TOML text (toml++ keeps
 // a table's keys sorted, so equal tables print alike), less the `drop` keys
 // ("table.key"), after `prefix`.
 std::string key_of(const std::string& prefix, const toml::table& doc, std::initializer_list<std::string_view> tables,
-                   std::initializer_list<std::string_view> drop = {}) {
+                   const std::vector<std::string_view>& drop = {}) {
   toml::table part;
   for (std::string_view t : tables)
     if (const toml::node* n = doc.get(t)) part.insert(t, *n);
@@ -106,6 +112,15 @@ class Cache {
     const std::string key = key_of(scalar_name(r.scene.scalar), r.table, {"frame", "device", "vines", "loop"},
                                    {"vines.initial_position_m", "vines.initial_velocity_mps"});
     return *get<double>(taus_, key, [&] { return build(r.scene, p)->info().vines.tau; });
+  }
+  // A run's parameters as built: a Kuwabara scene without tau gets the one it
+  // calibrates to.
+  SceneParams built_params(const RunScene& r) {
+    SceneParams p = r.scene.params;
+    if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
+        p.device.vines.tau_s == 0.0)
+      p.device.vines.tau_s = tau(r);
+    return p;
   }
   // VI NES free travel of a scene's design.
   double gap(const RunScene& r) {
@@ -156,14 +171,10 @@ class Cache {
                                    const std::vector<KeyValue>& values, bool need_gap) {
     return get<Base>(bases_, key + (need_gap ? "|gap" : ""), [&] {
       Base b{scene_with(table, origin, values), {}, {}, {}, {}, 0};
-      b.params = b.run.scene.params;
-      if (b.params.device.kind == DeviceKind::kVines && b.params.device.vines.law == ContactLaw::kKuwabara &&
-          b.params.device.vines.tau_s == 0.0)
-        b.params.device.vines.tau_s = tau(b.run);
+      b.params = built_params(b.run);
       // The model: every table but the record's, less the initial conditions.
       b.model_key = key_of(scalar_name(b.run.scene.scalar), b.run.table, {"frame", "device", "tmd", "vines", "loop"},
-                           {"vines.initial_position_m", "vines.initial_velocity_mps", "tmd.initial_position_m",
-                            "tmd.initial_velocity_mps"});
+                           {std::begin(kInitialConditionKeys), std::end(kInitialConditionKeys)});
       b.excitation = excitation(b.run);
       b.bare = bare(b.run);
       if (need_gap) b.gap = gap(b.run);
@@ -249,11 +260,9 @@ class EnginePool {
   std::size_t held_ = 0;
 };
 
-// Keys that only say where the device starts: runs that differ in nothing
-// else share a built model.
 bool initial_condition_key(const std::string& key) {
-  return key == "vines.initial_position_m" || key == "vines.initial_velocity_mps" ||
-         key == "tmd.initial_position_m" || key == "tmd.initial_velocity_mps";
+  return std::find(std::begin(kInitialConditionKeys), std::end(kInitialConditionKeys), key) !=
+         std::end(kInitialConditionKeys);
 }
 
 // Sets an initial condition in the parameters, as the scene reader does.
@@ -311,10 +320,7 @@ RunResult run_general(const StudySpec& st, const RunPlan& plan, const toml::tabl
     }
     run = scene_with(base, st.scene_path, values);
   }
-  SceneParams p = run.scene.params;
-  if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
-      p.device.vines.tau_s == 0.0)
-    p.device.vines.tau_s = cache.tau(run);
+  const SceneParams p = cache.built_params(run);
   ModelInfo info;
   const RunTotals t = Cache::run_totals(run.scene, p, *cache.excitation(run), stop, &info);
   return result_of(t, *cache.bare(run), p, info, run.scene.scalar);
