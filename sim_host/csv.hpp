@@ -13,6 +13,10 @@
 
 namespace vines::host {
 
+// A number in a printf format ("%.10g"), written to buf as snprintf would;
+// returns its length.
+int format_number(char* buf, std::size_t size, double v, const char* format);
+
 class CsvWriter {
  public:
   explicit CsvWriter(const std::string& path);  // starts the file's temporary copy
@@ -34,6 +38,7 @@ class CsvWriter {
   void separate();
 
   AtomicFile file_;
+  std::string row_;    // the row being written
   bool first_ = true;  // no cell yet in this row
 };
 

@@ -6,13 +6,18 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sim_host/csv.hpp"
 #include "sim_host/output.hpp"
@@ -223,4 +228,35 @@ TEST_F(OutputTest, EmptyPathAndFileInTheWayAreRefused) {
             path("file") + ": cannot create: a file of that name exists");
   const std::string below = message_of([&] { OutputDir(path("file/sub"), "vines run", {"summary.json"}); });
   EXPECT_EQ(below.rfind(path("file/sub") + ": cannot create: ", 0), 0u) << below;
+}
+
+// CsvWriter's numbers come from std::to_chars for "%.Nf", "%.Ng", "%.Ne": the
+// same text as snprintf (the C library's printf), on values that stress
+// rounding, exponents, subnormals, signed zeros and non-finite values.
+TEST(Csv, NumbersAreWhatPrintfWrites) {
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.5, 1.5, 2.5, 9.9999999995, 99999.99995, 1e-5, 1e-4,
+                                123456789.0, 1e15, 1e16, 1e17, 1e22, 1e300, -1e-300, 4.9e-324, 2.2250738585072014e-308,
+                                0.1, 0.2, 0.3, 1.0 / 3.0, 2.0 / 3.0, 3.14159265358979, -0.0139997764,
+                                std::numeric_limits<double>::max(), std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()};
+  std::uint64_t x = 0x9E3779B97F4A7C15ull;
+  for (int i = 0; i < 20000; ++i) {  // random bit patterns, and random values in the ranges outputs take
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    double v;
+    std::memcpy(&v, &x, sizeof v);
+    values.push_back(v);
+    values.push_back(static_cast<double>(x % 2000001) / 1000.0 - 1000.0);
+  }
+  for (const char* format : {"%.10g", "%.9g", "%.6g", "%.3g", "%.1g", "%.0g", "%.17g", "%.6f", "%.1f", "%.0f",
+                             "%.3e", "%.12e"}) {
+    for (double v : values) {
+      char want[512], got[512];
+      const int n = std::snprintf(want, sizeof want, format, v);
+      const int m = vines::host::format_number(got, sizeof got, v, format);
+      ASSERT_EQ(std::string(want, static_cast<std::size_t>(n)), std::string(got, static_cast<std::size_t>(m)))
+          << format << " of " << v;
+    }
+  }
 }
