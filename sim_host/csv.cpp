@@ -52,10 +52,16 @@ int format_number(char* buf, std::size_t size, double v, const char* format) {
 }
 
 CsvWriter& CsvWriter::number(double v, const char* format) {
-  char buf[64];
-  const int n = format_number(buf, sizeof buf, v, format);
+  char buf[512];  // "%.99f" of the largest double fits
+  int n = format_number(buf, sizeof buf, v, format);
   separate();
-  put(buf, static_cast<std::size_t>(n));
+  if (n >= 0 && static_cast<std::size_t>(n) < sizeof buf) {
+    put(buf, static_cast<std::size_t>(n));
+  } else {  // a longer printf format: its whole text
+    std::string big(n > 0 ? static_cast<std::size_t>(n) + 1 : 0, '\0');
+    n = n > 0 ? std::snprintf(big.data(), big.size(), format, v) : 0;
+    put(big.data(), static_cast<std::size_t>(n > 0 ? n : 0));
+  }
   return *this;
 }
 

@@ -260,3 +260,16 @@ TEST(Csv, NumbersAreWhatPrintfWrites) {
     }
   }
 }
+
+// A number longer than any short buffer is written whole.
+TEST_F(OutputTest, LongNumbersAreWrittenWhole) {
+  {
+    CsvWriter csv(path("long.csv"));
+    csv.number(1e300, "%.2f").number(-1e300, "%12.3f").end_row();
+    csv.close();
+  }
+  char want[1024];
+  const int a = std::snprintf(want, sizeof want, "%.2f,", 1e300);
+  std::snprintf(want + a, sizeof want - static_cast<std::size_t>(a), "%12.3f\n", -1e300);
+  EXPECT_EQ(read(path("long.csv")), std::string(want));
+}
