@@ -1,20 +1,25 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages of a set (default: all):
-#   main  what tools/main.sh needs: the compiler, CMake, the headers `vines`
-#         compiles against, TBB, and the plot script's Python libraries.
-#   all   main plus the tests and benchmarks, the CVODE baseline (SUNDIALS),
-#         MPI, the libFuzzer targets, the Cortex-M4F/M7 cross toolchain and
-#         QEMU for the MCU images (tools/test.sh, CI).
+#   build  what the `vines` program needs to compile: the compiler, CMake,
+#          the headers it compiles against, TBB
+#   plots  the plot scripts' Python libraries
+#   main   build and plots: what tools/main.sh needs (it installs plots
+#          while it compiles)
+#   all    main plus the tests and benchmarks, the CVODE baseline (SUNDIALS),
+#          MPI, the libFuzzer targets, the Cortex-M4F/M7 cross toolchain and
+#          QEMU for the MCU images (tools/test.sh, CI).
 # Installs only what is missing, so it is cheap to re-run.
 # Root or sudo; no questions asked (usable with no stdin, as in CI).
-# Usage: bash tools/setup.sh [main|all]
+# Usage: bash tools/setup.sh [build|plots|main|all]
 set -euo pipefail
 
-main=(
+build=(
   cmake make g++                                 # host build
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
   libcli11-dev                                   # the vines command line
   libtbb-dev                                     # the parallel map of sweep, design, stress
+)
+plots=(
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
 )
 rest=(
@@ -28,16 +33,18 @@ rest=(
 )
 
 if (($# > 1)); then
-  echo "usage: bash tools/setup.sh [main|all]" >&2
+  echo "usage: bash tools/setup.sh [build|plots|main|all]" >&2
   exit 2
 fi
 set_name=${1:-all}
 case $set_name in
-  main) packages=("${main[@]}") ;;
-  all) packages=("${main[@]}" "${rest[@]}") ;;
+  build) packages=("${build[@]}") ;;
+  plots) packages=("${plots[@]}") ;;
+  main) packages=("${build[@]}" "${plots[@]}") ;;
+  all) packages=("${build[@]}" "${plots[@]}" "${rest[@]}") ;;
   *)
-    echo "setup: unknown package set '$set_name' (main or all)" >&2
-    echo "usage: bash tools/setup.sh [main|all]" >&2
+    echo "setup: unknown package set '$set_name' (build, plots, main or all)" >&2
+    echo "usage: bash tools/setup.sh [build|plots|main|all]" >&2
     exit 2
     ;;
 esac
@@ -57,5 +64,8 @@ echo "setup ($set_name): installing ${missing[*]}"
 sudo=()
 if [[ $(id -u) -ne 0 ]]; then sudo=(sudo); fi
 "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null
+# --force-unsafe-io: dpkg does not fsync every file it unpacks (as in Debian's
+# container images); on a fresh machine that is most of the install's time. A
+# power cut during the install means running it again.
 "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive \
-  apt-get install -y -q --no-install-recommends "${missing[@]}" </dev/null
+  apt-get install -y -q --no-install-recommends -o Dpkg::Options::=--force-unsafe-io "${missing[@]}" </dev/null
