@@ -43,6 +43,8 @@ Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex,
   return tr;
 }
 
+}  // namespace
+
 json modal_json(const ModelInfo& in) {
   const int n = in.stories;
   json mass_fraction = json::array(), shapes = json::array();
@@ -58,6 +60,8 @@ json modal_json(const ModelInfo& in) {
           {"mode_shapes", shapes},  // phi_j * gamma_j, bottom floor first (Table 1's normalisation)
           {"total_mass_kg", in.total_mass}};
 }
+
+namespace {
 
 json response_json(const RunTotals& t, int n) {
   return {{"peak_displacement_m", head(t.peak_x, n)},
@@ -120,6 +124,26 @@ void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev
   csv.close();
 }
 
+// The scene's pga_g, the resampling to the sensor rate and duration_s, on a
+// loaded record (its scale already applied).
+Excitation finish_excitation(const Scene& scene, Excitation ex) {
+  const std::string& path = ex.record.path;
+  if (scene.target_pga_mps2 > 0.0) {
+    const double pga = ex.record.pga_mps2();
+    if (!(pga > 0.0)) throw std::runtime_error(path + ": all samples are zero, cannot scale to pga_g");
+    for (double& a : ex.record.accel_mps2) a *= scene.target_pga_mps2 / pga;
+  }
+  ex.rate_hz = scene.params.loop.sensor_rate_hz;
+  ex.samples = hal::resample(ex.record, ex.rate_hz);
+  if (scene.duration_s > 0.0) {
+    const auto keep = static_cast<std::size_t>(std::llround(scene.duration_s * ex.rate_hz)) + 1;
+    if (keep < ex.samples.size()) ex.samples.resize(keep);
+  }
+  if (ex.samples.size() < 2)
+    throw std::runtime_error(path + ": record too short for one step at the sensor rate");
+  return ex;
+}
+
 }  // namespace
 
 Excitation load_excitation(const Scene& scene, const std::string& record_override,
@@ -145,28 +169,28 @@ Excitation load_excitation(const Scene& scene, const std::string& record_overrid
   }
   Excitation ex;
   ex.record = hal::load_record(spec);
-  if (scene.target_pga_mps2 > 0.0) {
-    const double pga = ex.record.pga_mps2();
-    if (!(pga > 0.0)) throw std::runtime_error(spec.path + ": all samples are zero, cannot scale to pga_g");
-    for (double& a : ex.record.accel_mps2) a *= scene.target_pga_mps2 / pga;
-  }
-  ex.rate_hz = scene.params.loop.sensor_rate_hz;
-  ex.samples = hal::resample(ex.record, ex.rate_hz);
-  if (scene.duration_s > 0.0) {
-    const auto keep = static_cast<std::size_t>(std::llround(scene.duration_s * ex.rate_hz)) + 1;
-    if (keep < ex.samples.size()) ex.samples.resize(keep);
-  }
-  if (ex.samples.size() < 2)
-    throw std::runtime_error(spec.path + ": record too short for one step at the sensor rate");
-  return ex;
+  return finish_excitation(scene, std::move(ex));
+}
+
+Excitation excitation_from_record(const Scene& scene, hal::Record record) {
+  hal::check_record(record);
+  for (double& a : record.accel_mps2) a *= scene.record.scale;
+  Excitation ex;
+  ex.record = std::move(record);
+  return finish_excitation(scene, std::move(ex));
 }
 
 RunReport run_scene(const Scene& scene, const RunOptions& opt) {
-  const Excitation ex = load_excitation(scene, opt.record_override, opt.record_reading);
+  return run_scene(scene, load_excitation(scene, opt.record_override, opt.record_reading), opt);
+}
+
+RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& opt) {
   const SceneParams& p = scene.params;
   const bool has_device = p.device.kind != DeviceKind::kNone;
   const bool series = !opt.out_dir.empty() && scene.output.timeseries;
-  const int every = series ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz)) : 0;
+  const int every = series || opt.keep_series
+                        ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz))
+                        : 0;
 
   // The device run, and with a device the bare frame on the same samples.
   const Trace dev = run_engine(scene, p, ex, every);
@@ -200,6 +224,10 @@ RunReport run_scene(const Scene& scene, const RunOptions& opt) {
     }
     write_file_atomic(out.file("summary.json"), r.to_json().dump(2) + '\n');
     out.finish(written);
+  }
+  if (opt.keep_series) {
+    r.series = dev.rows;
+    if (has_device) r.bare_series = bare.rows;
   }
   return r;
 }

@@ -30,6 +30,7 @@ struct RunOptions {
   RecordReading record_reading;  // how to read it
   std::string out_dir;          // --out DIR ("" = write nothing)
   bool quiet = false;
+  bool keep_series = false;     // the time series (output rate) in RunReport::series (Python)
 };
 
 // The record of a scene, loaded, scaled and resampled to the sensor rate.
@@ -46,6 +47,11 @@ inline double reduction(double bare, double with_device) { return (bare - with_d
 // The scene's record, or record_override ("" = none) read as `reading` says.
 Excitation load_excitation(const Scene& scene, const std::string& record_override,
                            const RecordReading& reading = {});
+
+// The excitation of a record already in memory (m/s^2, checked as a file's
+// would be: hal::check_record), as the scene runs it: its scale or pga_g,
+// resampled to the sensor rate, cut to duration_s.
+Excitation excitation_from_record(const Scene& scene, hal::Record record);
 
 // The record a run read, as loaded and scaled.
 struct RecordSummary {
@@ -67,6 +73,9 @@ struct RunReport {
   std::optional<RunTotals> bare;  // with a device: the bare frame on the same record
   double wall_s = 0;              // the device run's loop
   RunStatus status;               // ok, or degraded and why (either run)
+  // With RunOptions::keep_series: the steps at the output rate (t = 0 first),
+  // of the device run and (with a device) the bare frame.
+  std::vector<Snapshot> series, bare_series;
   double x_r() const { return reduction(bare->peak_top, totals.peak_top); }
   double E_r() const { return reduction(bare->elastic_energy, totals.elastic_energy); }
   nlohmann::json to_json() const;
@@ -77,5 +86,11 @@ struct RunReport {
 // given). Throws std::runtime_error with a message naming the input on any
 // user error.
 RunReport run_scene(const Scene& scene, const RunOptions& opt);
+// The same on an excitation already loaded (opt.record_override unused).
+RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& opt);
+
+// The modal report of summary.json ("modal"): frequencies, damping ratios,
+// participation, effective masses, mode shapes.
+nlohmann::json modal_json(const ModelInfo& info);
 
 }  // namespace vines::host

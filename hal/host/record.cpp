@@ -275,20 +275,24 @@ Raw parse_time_accel(const Table& t, const RecordSpec& spec) {
   return raw;
 }
 
-double unit_factor(Units u) {
-  switch (u) {
-    case Units::kG: return kG;
-    case Units::kMps2: return 1.0;
-    case Units::kCmps2: return 0.01;
-  }
-  return 1.0;
-}
-
 // A record's dt must be in [kMinRecordDt, kMaxRecordDt].
 void check_dt(const std::string& path, double dt) {
   if (!(std::isfinite(dt) && dt >= kMinRecordDt && dt <= kMaxRecordDt)) {
     fail(path, "dt " + fmt(dt) + " s is outside [" + fmt(kMinRecordDt) + ", " + fmt(kMaxRecordDt) +
                    "] s");
+  }
+}
+
+// Points, dt and end time of a record within the limits. A few bytes must
+// not ask for days of samples (found by record_fuzz: a huge DT or a time
+// column that starts late; the run would simulate it all).
+void check_extent(const std::string& path, std::size_t points, double dt, double t0) {
+  check_count(path, points, "points");
+  check_dt(path, dt);
+  const double end_s = t0 + dt * static_cast<double>(points);
+  if (!(end_s <= kMaxRecordEndS)) {
+    fail(path, "the record ends at t = " + fmt(end_s) + " s, later than the " + fmt(kMaxRecordEndS) +
+                   " s a record may last (check DT or the time column)");
   }
 }
 
@@ -313,15 +317,7 @@ Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
               ? parse_accel(lines, spec)
               : parse_time_accel(table, spec);
   }
-  check_count(spec.path, raw.values.size(), "points");
-  check_dt(spec.path, raw.dt);
-  // A few bytes must not ask for days of samples (found by record_fuzz: a
-  // huge DT or a time column that starts late; the run would simulate it all).
-  const double end_s = raw.t0 + raw.dt * static_cast<double>(raw.values.size());
-  if (!(end_s <= kMaxRecordEndS)) {
-    fail(spec.path, "the record ends at t = " + fmt(end_s) + " s, later than the " +
-                        fmt(kMaxRecordEndS) + " s a record may last (check DT or the time column)");
-  }
+  check_extent(spec.path, raw.values.size(), raw.dt, raw.t0);
 
   Record rec;
   rec.path = spec.path;
@@ -421,6 +417,22 @@ bool RecordSource::next(double* accel_mps2) {
   }
   *accel_mps2 = samples_[pos_++];
   return true;
+}
+
+double unit_factor(Units u) {
+  switch (u) {
+    case Units::kG: return kG;
+    case Units::kMps2: return 1.0;
+    case Units::kCmps2: return 0.01;
+  }
+  return 1.0;
+}
+
+void check_record(const Record& record) {
+  if (record.accel_mps2.empty()) fail(record.path, "no samples");
+  check_extent(record.path, record.accel_mps2.size(), record.dt_s, record.t0_s);
+  for (std::size_t i = 0; i < record.accel_mps2.size(); ++i)
+    if (!std::isfinite(record.accel_mps2[i])) fail(record.path, "sample " + std::to_string(i) + " is not finite");
 }
 
 }  // namespace vines::hal

@@ -71,6 +71,14 @@ Record load_record(const RecordSpec& spec);
 // spec.path only names the record in messages.
 Record parse_record(const std::string& text, const RecordSpec& spec);
 
+// m/s^2 per unit.
+double unit_factor(Units u);
+
+// The same limits on a record built in memory (a Python array): at least
+// one sample, every one finite, the point count, dt and end time as for a
+// file; RecordError naming record.path otherwise.
+void check_record(const Record& record);
+
 // The format of a record file as kAuto would read it: kAt2 if an NPTS/DT
 // header line is in its first lines, else kTimeAccel for two or more columns,
 // kAccel for one. RecordError if the file cannot be read.
