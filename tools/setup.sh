@@ -6,8 +6,9 @@
 #   main   build and plots: what tools/main.sh needs (it installs plots
 #          while it compiles)
 #   all    main plus the tests and benchmarks, the CVODE baseline (SUNDIALS),
-#          MPI, the libFuzzer targets, the Cortex-M4F/M7 cross toolchain and
-#          QEMU for the MCU images (tools/test.sh, CI).
+#          the Python package (pybind11) and pytest, MPI, the libFuzzer
+#          targets, the Cortex-M4F/M7 cross toolchain and QEMU for the MCU
+#          images (tools/test.sh, CI).
 # Installs only what is missing, so it is cheap to re-run.
 # Root or sudo; no questions asked (usable with no stdin, as in CI).
 # Usage: bash tools/setup.sh [build|plots|main|all]
@@ -25,6 +26,7 @@ plots=(
 rest=(
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libsundials-dev                                # CVODE baseline (vines bench, tests)
+  pybind11-dev python3-dev python3-pytest        # the Python package and its tests
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
   clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets

@@ -1,0 +1,275 @@
+// The `vines._vines` extension (pybind11): the host library's scenes,
+// records, runs and modal report for Python. The package around it
+// (vines/__init__.py) gives the results their Python shape (attributes,
+// numpy arrays); every check and message is the command line's own.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <toml++/toml.h>
+
+#include <cstddef>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "host/record.hpp"
+#include "sim_host/build_engine.hpp"
+#include "sim_host/run.hpp"
+#include "sim_host/scene.hpp"
+#include "sim_host/scene_toml.hpp"
+
+namespace py = pybind11;
+using namespace vines;
+using namespace vines::host;
+
+namespace {
+
+// A scene: its TOML table (what with_() edits and to_toml() writes) and the
+// checked Scene made from it. origin names it in messages and is the path
+// relative record paths are resolved against.
+struct PyScene {
+  toml::table table;
+  std::string origin;
+  Scene scene;
+};
+
+PyScene make_scene(toml::table table, const std::string& origin) {
+  Scene s = scene_from_table(table, origin);
+  return {std::move(table), origin, std::move(s)};
+}
+
+// Python values as TOML nodes: bool, int, float, str, list (or tuple), dict
+// (nested). `where` names the value in messages: "origin: section.key".
+toml::table to_table(const py::dict& d, const std::string& origin, const std::string& prefix);
+
+[[noreturn]] void bad_type(const std::string& where, const py::handle v) {
+  throw SceneError(where + ": a value of type " + std::string(py::str(v.get_type().attr("__name__"))) +
+                   " (bool, int, float, str, list or dict)");
+}
+
+toml::array to_array(const py::handle l, const std::string& origin, const std::string& key) {
+  toml::array out;
+  for (const py::handle item : l) {
+    if (py::isinstance<py::bool_>(item)) out.push_back(item.cast<bool>());
+    else if (py::isinstance<py::int_>(item)) out.push_back(item.cast<std::int64_t>());
+    else if (py::isinstance<py::float_>(item)) out.push_back(item.cast<double>());
+    else if (py::isinstance<py::str>(item)) out.push_back(item.cast<std::string>());
+    else if (py::isinstance<py::list>(item) || py::isinstance<py::tuple>(item)) out.push_back(to_array(item, origin, key));
+    else if (py::isinstance<py::dict>(item)) out.push_back(to_table(item.cast<py::dict>(), origin, key));
+    else bad_type(origin + ": " + key, item);
+  }
+  return out;
+}
+
+void insert(toml::table& t, const std::string& name, const py::handle v, const std::string& origin,
+            const std::string& key) {
+  if (py::isinstance<py::bool_>(v)) t.insert_or_assign(name, v.cast<bool>());
+  else if (py::isinstance<py::int_>(v)) t.insert_or_assign(name, v.cast<std::int64_t>());
+  else if (py::isinstance<py::float_>(v)) t.insert_or_assign(name, v.cast<double>());
+  else if (py::isinstance<py::str>(v)) t.insert_or_assign(name, v.cast<std::string>());
+  else if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) t.insert_or_assign(name, to_array(v, origin, key));
+  else if (py::isinstance<py::dict>(v)) t.insert_or_assign(name, to_table(v.cast<py::dict>(), origin, key));
+  else bad_type(origin + ": " + key, v);
+}
+
+toml::table to_table(const py::dict& d, const std::string& origin, const std::string& prefix) {
+  toml::table out;
+  for (const auto& [k, v] : d) {
+    const std::string name = py::str(k);
+    insert(out, name, v, origin, prefix.empty() ? name : prefix + "." + name);
+  }
+  return out;
+}
+
+// Sets "section.key" (dotted, as in study specs) in a copy of the table.
+PyScene with_overrides(const PyScene& s, const py::dict& overrides) {
+  toml::table t = s.table;
+  for (const auto& [k, v] : overrides) {
+    const std::string key = py::str(k);
+    toml::table* at = &t;
+    std::size_t start = 0;
+    for (std::size_t dot; (dot = key.find('.', start)) != std::string::npos; start = dot + 1) {
+      const std::string part = key.substr(start, dot - start);
+      toml::node* n = at->get(part);
+      if (!n) n = &at->insert_or_assign(part, toml::table{}).first->second;
+      if (!n->is_table()) throw SceneError(s.origin + ": " + key + ": " + part + " is not a table");
+      at = n->as_table();
+    }
+    insert(*at, key.substr(start), v, s.origin, key);
+  }
+  return make_scene(std::move(t), s.origin);
+}
+
+hal::Units units_of(const std::string& u) {
+  if (u == "g") return hal::Units::kG;
+  if (u == "m/s2") return hal::Units::kMps2;
+  if (u == "cm/s2") return hal::Units::kCmps2;
+  throw std::invalid_argument("units: '" + u + "' (g, m/s2 or cm/s2)");
+}
+
+hal::RecordFormat format_of(const std::string& f) {
+  if (f == "auto") return hal::RecordFormat::kAuto;
+  if (f == "at2") return hal::RecordFormat::kAt2;
+  if (f == "time-accel") return hal::RecordFormat::kTimeAccel;
+  if (f == "accel") return hal::RecordFormat::kAccel;
+  throw std::invalid_argument("format: '" + f + "' (auto, at2, time-accel or accel)");
+}
+
+// A ground-motion record: read from a file (then a run reads that file the
+// way `vines run --record` does) or given as samples.
+struct PyRecord {
+  hal::Record record;
+  bool from_file = false;
+  RecordReading reading;
+};
+
+PyRecord load_record(const std::string& path, const std::string& format, const std::string& units, int column,
+                     double dt) {
+  PyRecord r;
+  r.from_file = true;
+  r.reading.format = format_of(format);
+  r.reading.units = units_of(units);
+  r.reading.column = column;
+  r.reading.dt_s = dt;
+  hal::RecordSpec spec;
+  spec.path = path;
+  spec.format = r.reading.format;
+  spec.units = r.reading.units;
+  spec.column = column;
+  spec.dt_s = dt;
+  r.record = hal::load_record(spec);
+  return r;
+}
+
+PyRecord record_from_array(const py::array_t<double, py::array::c_style | py::array::forcecast>& acc, double dt,
+                           double t0, const std::string& units, const std::string& name) {
+  if (acc.ndim() != 1) throw std::invalid_argument(name + ": acc must be one-dimensional");
+  PyRecord r;
+  r.record.path = name;
+  r.record.dt_s = dt;
+  r.record.t0_s = t0;
+  const double f = hal::unit_factor(units_of(units));
+  const auto a = acc.unchecked<1>();
+  r.record.accel_mps2.resize(static_cast<std::size_t>(a.shape(0)));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i) r.record.accel_mps2[static_cast<std::size_t>(i)] = a(i) * f;
+  hal::check_record(r.record);
+  return r;
+}
+
+// One column of snapshots as a numpy array.
+template <typename F>
+py::array_t<double> column(const std::vector<Snapshot>& rows, F get) {
+  py::array_t<double> out(static_cast<py::ssize_t>(rows.size()));
+  auto o = out.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < rows.size(); ++i) o(static_cast<py::ssize_t>(i)) = get(rows[i]);
+  return out;
+}
+
+// Per-floor columns (rows x stories).
+py::array_t<double> floors(const std::vector<Snapshot>& rows, int stories, const FloorArray Snapshot::*field) {
+  py::array_t<double> out({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(stories)});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (int j = 0; j < stories; ++j) o(static_cast<py::ssize_t>(i), j) = (rows[i].*field)[static_cast<std::size_t>(j)];
+  return out;
+}
+
+py::dict series_dict(const std::vector<Snapshot>& rows, int stories) {
+  py::dict d;
+  d["t"] = column(rows, [](const Snapshot& s) { return s.t; });
+  d["ag"] = column(rows, [](const Snapshot& s) { return s.ag; });
+  d["x"] = floors(rows, stories, &Snapshot::x);
+  d["v"] = floors(rows, stories, &Snapshot::v);
+  d["acc"] = floors(rows, stories, &Snapshot::acc);
+  d["drift"] = floors(rows, stories, &Snapshot::drift);
+  d["elastic_energy"] = column(rows, [](const Snapshot& s) { return s.elastic_energy; });
+  d["particle_x"] = column(rows, [](const Snapshot& s) { return s.particle_x; });
+  d["particle_v"] = column(rows, [](const Snapshot& s) { return s.particle_v; });
+  d["wall_left"] = column(rows, [](const Snapshot& s) { return s.wall_left; });
+  d["wall_right"] = column(rows, [](const Snapshot& s) { return s.wall_right; });
+  d["contact_force"] = column(rows, [](const Snapshot& s) { return s.contact_force; });
+  d["mode"] = column(rows, [](const Snapshot& s) { return static_cast<double>(s.mode); });
+  d["tmd_x"] = column(rows, [](const Snapshot& s) { return s.tmd_x; });
+  d["tmd_v"] = column(rows, [](const Snapshot& s) { return s.tmd_v; });
+  return d;
+}
+
+// Runs a scene (on its own record, or `record`), the GIL released while the
+// loop runs; returns the summary (summary.json's text) and the series.
+py::dict run(const PyScene& s, const PyRecord* record) {
+  RunOptions opt;
+  opt.keep_series = true;
+  RunReport r;
+  {
+    Excitation ex;
+    bool have_ex = false;
+    if (record && !record->from_file) {
+      ex = excitation_from_record(s.scene, record->record);
+      have_ex = true;
+    } else if (record) {
+      opt.record_override = record->record.path;
+      opt.record_reading = record->reading;
+    }
+    py::gil_scoped_release release;
+    r = have_ex ? run_scene(s.scene, ex, opt) : run_scene(s.scene, opt);
+  }
+  py::dict out;
+  out["summary"] = r.to_json().dump();
+  out["series"] = series_dict(r.series, r.info.stories);
+  if (r.bare) out["bare_series"] = series_dict(r.bare_series, r.info.stories);
+  return out;
+}
+
+// The modal report of the scene's frame (with its device's floor), as JSON text.
+std::string modal(const PyScene& s) {
+  std::unique_ptr<Engine> eng = build_engine(s.scene.params, s.scene.scalar, s.scene.path);
+  return modal_json(eng->info()).dump();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_vines, m) {
+  m.doc() = "vines core: scenes, records, runs (see the vines package)";
+  py::register_exception<SceneError>(m, "SceneError", PyExc_ValueError);
+  py::register_exception<hal::RecordError>(m, "RecordError", PyExc_ValueError);
+
+  py::class_<PyScene>(m, "Scene")
+      .def_static("load", [](const std::string& path) { return make_scene(read_scene_table(path), path); },
+                  py::arg("path"))
+      .def_static("from_toml", [](const std::string& text, const std::string& origin) {
+        return make_scene(parse_scene_table(text, origin), origin);
+      }, py::arg("text"), py::arg("origin"))
+      .def_static("from_dict", [](const py::dict& d, const std::string& origin) {
+        return make_scene(to_table(d, origin, ""), origin);
+      }, py::arg("d"), py::arg("origin"))
+      .def("with_", &with_overrides, py::arg("overrides"))
+      .def("to_toml", [](const PyScene& s) {
+        std::ostringstream os;
+        os << s.table;
+        return os.str() + "\n";
+      })
+      .def_property_readonly("name", [](const PyScene& s) { return s.scene.name; })
+      .def_property_readonly("origin", [](const PyScene& s) { return s.origin; })
+      .def_property_readonly("stories", [](const PyScene& s) { return s.scene.params.frame.stories; })
+      .def_property_readonly("sensor_rate_hz", [](const PyScene& s) { return s.scene.params.loop.sensor_rate_hz; })
+      .def_property_readonly("output_rate_hz", [](const PyScene& s) { return s.scene.output.rate_hz; });
+
+  py::class_<PyRecord>(m, "Record")
+      .def_static("load", &load_record, py::arg("path"), py::arg("format"), py::arg("units"), py::arg("column"),
+                  py::arg("dt"))
+      .def_static("from_array", &record_from_array, py::arg("acc"), py::arg("dt"), py::arg("t0"), py::arg("units"),
+                  py::arg("name"))
+      .def_property_readonly("path", [](const PyRecord& r) { return r.record.path; })
+      .def_property_readonly("dt", [](const PyRecord& r) { return r.record.dt_s; })
+      .def_property_readonly("t0", [](const PyRecord& r) { return r.record.t0_s; })
+      .def_property_readonly("acc", [](const PyRecord& r) {
+        return py::array_t<double>(static_cast<py::ssize_t>(r.record.accel_mps2.size()), r.record.accel_mps2.data());
+      })
+      .def_property_readonly("pga", [](const PyRecord& r) { return r.record.pga_mps2(); })
+      .def("__len__", [](const PyRecord& r) { return r.record.accel_mps2.size(); });
+
+  m.def("run", &run, py::arg("scene"), py::arg("record") = nullptr);
+  m.def("modal", &modal, py::arg("scene"));
+}
