@@ -550,7 +550,9 @@ std::vector<RunResult> execute(const SweepSpec& spec, const std::vector<RunPlan>
                                int offset, int stride, const std::atomic<bool>* stop, bool progress,
                                SweepLog* log, std::vector<RunResult> finished) {
   std::vector<toml::table> bases;
-  for (const StudySpec& st : spec.studies) bases.push_back(read_scene_table(st.scene_path));
+  for (const StudySpec& st : spec.studies)
+    bases.push_back(st.scene_toml.empty() ? read_scene_table(st.scene_path)
+                                          : parse_scene_table(st.scene_toml, st.scene_path));
   std::vector<RunResult> results = finished.empty() ? std::vector<RunResult>(plan.size()) : std::move(finished);
   // This rank's runs not yet done: every stride-th from offset, each stored at its index.
   std::vector<std::size_t> mine;

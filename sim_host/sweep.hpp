@@ -81,6 +81,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(RunResult, done, error, device, 
 
 struct StudySpec {
   std::string name, scene_path, group_by, optimize;
+  // The scene as TOML text, when it is not the file scene_path (a scene of
+  // the Python package): scene_path then names it and resolves its record.
+  std::string scene_toml;
   std::vector<KeyValue> set;
   std::vector<std::vector<KeyValue>> cases;
   std::vector<std::vector<KeyValue>> grid_axes;  // one list of values per key
@@ -96,6 +99,9 @@ struct SweepSpec {
 inline constexpr std::uint64_t kMaxPlanRuns = 1000000000;
 
 SweepSpec load_sweep(const std::string& path);
+// The same from the spec's text (path names it and anchors relative scene
+// and folder paths); the studies' scenes are not loaded.
+SweepSpec parse_sweep(const std::string& text, const std::string& path);
 
 // The number of runs of the spec, from its axes (nothing materialised);
 // UINT64_MAX when the product overflows.

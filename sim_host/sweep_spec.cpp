@@ -219,13 +219,20 @@ std::string KeyValue::label() const {
 
 // ---- spec file ----
 SweepSpec load_sweep(const std::string& path) {
-  toml::table root;
   std::string text;
   try {
     text = hal::read_input_file(path, kMaxSceneBytes);  // a regular file of bounded size
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string(e.what()) + " (a study spec)");
   }
+  SweepSpec spec = parse_sweep(text, path);
+  // Every study's scene must load.
+  for (const StudySpec& st : spec.studies) load_scene(st.scene_path);
+  return spec;
+}
+
+SweepSpec parse_sweep(const std::string& text, const std::string& path) {
+  toml::table root;
   try {
     root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
@@ -297,8 +304,6 @@ SweepSpec load_sweep(const std::string& path) {
     }
     spec.studies.push_back(st);
   }
-  // Every study's scene must load.
-  for (const StudySpec& st : spec.studies) load_scene(st.scene_path);
   return spec;
 }
 

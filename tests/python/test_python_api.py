@@ -194,8 +194,33 @@ def test_the_readme_python_section_runs_as_written(capfd):
         os.chdir(cwd)
     out = capfd.readouterr().out
     assert "ok" in out and "(5377,)" in out  # status; t at 100 rows a second of 53.76 s
+    assert "['ok' 'ok' 'ok']" in out  # the sweep's three runs
     # The shell line of the section, as written (the package on PYTHONPATH as CTest sets it).
     line = next(l for l in section.splitlines() if l.startswith("PYTHONPATH="))
     cmd = line.split(" ", 1)[1]
     res = subprocess.run(["bash", "-c", cmd], cwd=SOURCE, capture_output=True, text=True, check=True)
     assert res.stdout.startswith("vines.Result(scene 'elcentro_vines', status ok")
+
+
+def test_a_sweep_equals_the_program(tmp_path, vines_scene):
+    grid = {"vines.beta": [1.2, 1.35, 1.5], "loop.sensor_rate_hz": {"from": 200.0, "to": 500.0, "count": 2}}
+    table = vines.sweep(vines_scene, grid=grid, threads=2)
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[[study]]\nname = "py"\nscene = "%s"\n[study.grid]\n"vines.beta" = [1.2, 1.35, 1.5]\n'
+                    '"loop.sensor_rate_hz" = {from = 200.0, to = 500.0, count = 2}\n' % vines_scene.origin)
+    subprocess.run([VINES_EXE, "sweep", str(spec), "--out", str(tmp_path / "out"), "--no-progress"], check=True,
+                   capture_output=True)
+    with open(tmp_path / "out" / "results.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(table) == len(rows) == 6
+    for key in ("vines.beta", "loop.sensor_rate_hz", "x_r", "E_r"):
+        np.testing.assert_allclose(np.asarray(table[key], dtype=float), [float(r[key]) for r in rows], rtol=1e-9)
+    assert list(np.asarray(table["status"])) == ["ok"] * 6
+    # A run whose key is wrong fails alone, its error naming the key.
+    bad = vines.sweep(vines_scene, grid={"vines.beta": [1.35, 0.5]})
+    status = dict(zip(np.asarray(bad["vines.beta"]), np.asarray(bad["status"])))
+    assert status == {1.35: "ok", 0.5: "failed"}
+    failed = int(np.flatnonzero(np.asarray(bad["vines.beta"]) == 0.5)[0])
+    assert "vines.beta" in bad["error"][failed] and math.isnan(bad["x_r"][failed])
+    with pytest.raises(Exception, match="group_by"):
+        vines.sweep(vines_scene, grid={"vines.beta": [1.35]}, group_by="vines.eps")

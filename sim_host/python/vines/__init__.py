@@ -18,7 +18,7 @@ import numpy as _np
 from . import _vines
 from ._vines import RecordError, SceneError
 
-__all__ = ["Scene", "Record", "Result", "run", "modal", "SceneError", "RecordError"]
+__all__ = ["Scene", "Record", "Result", "run", "sweep", "modal", "SceneError", "RecordError"]
 
 
 class Scene:
@@ -157,6 +157,31 @@ def run(scene, record=None):
     `vines run --record`). With a device the bare frame runs too (x_r, E_r).
     The loop runs with the GIL released."""
     return Result(_vines.run(scene._impl, None if record is None else record._impl))
+
+
+def sweep(scene, grid=None, set=None, cases=None, group_by=None, threads=0):
+    """Runs `scene` as `vines sweep` runs a study (data/studies/README.md):
+    grid {"section.key": [values] or {"from", "to", "step" | "count",
+    "scale"}}, set {"section.key": value} fixed, cases [{"section.key":
+    value, ...}, ...] paired; the runs are the cases times the grid, on
+    `threads` C++ threads (0: every core) with the GIL released (Ctrl-C
+    stops them). Returns one row per run, in results.csv's order: the keys'
+    values (results.csv's column names), x_r, E_r, peak_top_displacement_m,
+    elastic_energy_integral, contacts, status (ok, degraded or failed),
+    degraded_reasons, error; a pandas DataFrame when pandas is installed,
+    else a numpy record array."""
+    raw = _vines.sweep(scene._impl, dict(grid or {}), dict(set or {}), list(cases or []), group_by or "",
+                       int(threads))
+    columns = {key: _np.asarray(values) for key, values in zip(raw["keys"], raw["values"])}
+    for name in ("x_r", "E_r", "peak_top_displacement_m", "elastic_energy_integral", "contacts"):
+        columns[name] = raw[name]
+    for name in ("status", "degraded_reasons", "error"):
+        columns[name] = _np.asarray(raw[name], dtype=str)
+    try:
+        import pandas
+    except ImportError:
+        return _np.rec.fromarrays(list(columns.values()), names=list(columns))
+    return pandas.DataFrame(columns)
 
 
 def modal(scene):
