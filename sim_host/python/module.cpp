@@ -227,6 +227,75 @@ py::dict run(const PyScene& s, const PyRecord* record) {
   return out;
 }
 
+// The excitation a run of the scene steps through: its record (or
+// `record`) scaled and resampled to the sensor rate [m/s^2].
+py::array_t<double> samples(const PyScene& s, const PyRecord* record) {
+  Excitation ex;
+  if (record && !record->from_file) ex = excitation_from_record(s.scene, record->record);
+  else if (record) ex = load_excitation(s.scene, record->record.path, record->reading);
+  else ex = load_excitation(s.scene, "");
+  return py::array_t<double>(static_cast<py::ssize_t>(ex.samples.size()), ex.samples.data());
+}
+
+py::array_t<double> floor_array(const FloorArray& a, int stories) {
+  return py::array_t<double>(stories, a.data());
+}
+
+// One step's outputs (a Snapshot) as a dict.
+py::dict step_dict(const Snapshot& s, int stories) {
+  py::dict d;
+  d["t"] = s.t;
+  d["ag"] = s.ag;
+  d["x"] = floor_array(s.x, stories);
+  d["v"] = floor_array(s.v, stories);
+  d["acc"] = floor_array(s.acc, stories);
+  d["drift"] = floor_array(s.drift, stories);
+  d["elastic_energy"] = s.elastic_energy;
+  d["particle_x"] = s.particle_x;
+  d["particle_v"] = s.particle_v;
+  d["wall_left"] = s.wall_left;
+  d["wall_right"] = s.wall_right;
+  d["contact_force"] = s.contact_force;
+  d["mode"] = s.mode;
+  d["tmd_x"] = s.tmd_x;
+  d["tmd_v"] = s.tmd_v;
+  return d;
+}
+
+// The scene's device run stepped from Python, one sample at a time (a
+// digital-twin prototype): the engine `vines run` uses, built once.
+struct PyLoop {
+  std::unique_ptr<Engine> eng;
+  int stories = 0;
+  bool started = false;
+
+  void require_started() const {
+    if (!started) throw std::runtime_error("vines.Loop: reset(a0) first (the ground acceleration at t = 0)");
+  }
+};
+
+PyLoop make_loop(const PyScene& s) {
+  PyLoop l;
+  l.eng = build_engine(s.scene.params, s.scene.scalar, s.scene.path);
+  l.stories = l.eng->info().stories;
+  return l;
+}
+
+py::dict totals_dict(const RunTotals& t, int stories) {
+  py::dict d;
+  d["peak_top_displacement_m"] = t.peak_top;
+  d["t_peak_top_s"] = t.t_peak_top;
+  d["peak_displacement_m"] = floor_array(t.peak_x, stories);
+  d["peak_drift_m"] = floor_array(t.peak_drift, stories);
+  d["elastic_energy_integral"] = t.elastic_energy;
+  d["contacts"] = t.count.contacts;
+  d["max_overlap_m"] = t.max_overlap;
+  d["steps"] = t.count.steps;
+  d["bad_samples_held"] = t.count.bad_samples;
+  d["divergences_rolled_back"] = t.count.divergences;
+  return d;
+}
+
 // A study of the scene as `vines sweep` runs one: grid (a key's list of
 // values, or {from, to, step | count, scale}, as in [study.grid]), set (fixed
 // keys), cases (a list of dicts of paired keys), on `threads` threads (0: all
@@ -370,7 +439,34 @@ PYBIND11_MODULE(_vines, m) {
       .def_property_readonly("pga", [](const PyRecord& r) { return r.record.pga_mps2(); })
       .def("__len__", [](const PyRecord& r) { return r.record.accel_mps2.size(); });
 
+  py::class_<PyLoop>(m, "Loop")
+      .def(py::init(&make_loop), py::arg("scene"))
+      .def("reset", [](PyLoop& l, double a0) {
+        l.eng->init(a0);
+        l.started = true;
+        return step_dict(l.eng->snapshot(), l.stories);
+      }, py::arg("a0"))
+      .def("step", [](PyLoop& l, double a) {
+        l.require_started();
+        l.eng->step(a);
+        return step_dict(l.eng->snapshot(), l.stories);
+      }, py::arg("a"))
+      .def("run", [](PyLoop& l, const py::array_t<double, py::array::c_style | py::array::forcecast>& a) {
+        l.require_started();
+        if (a.ndim() != 1) throw std::invalid_argument("vines.Loop.run: the samples must be one-dimensional");
+        {
+          py::gil_scoped_release release;
+          l.eng->run(a.data(), static_cast<std::size_t>(a.shape(0)));
+        }
+        return step_dict(l.eng->snapshot(), l.stories);
+      }, py::arg("samples"))
+      .def_property_readonly("totals", [](const PyLoop& l) {
+        l.require_started();
+        return totals_dict(l.eng->totals(), l.stories);
+      });
+
   m.def("run", &run, py::arg("scene"), py::arg("record") = nullptr);
+  m.def("samples", &samples, py::arg("scene"), py::arg("record") = nullptr);
   m.def("modal", &modal, py::arg("scene"));
   m.def("sweep", &sweep, py::arg("scene"), py::arg("grid"), py::arg("set"), py::arg("cases"), py::arg("group_by"),
         py::arg("threads"));

@@ -195,6 +195,7 @@ def test_the_readme_python_section_runs_as_written(capfd):
     out = capfd.readouterr().out
     assert "ok" in out and "(5377,)" in out  # status; t at 100 rows a second of 53.76 s
     assert "['ok' 'ok' 'ok']" in out  # the sweep's three runs
+    assert "\n1.0 " in out  # the loop's last step, at t = 1 s
     # The shell line of the section, as written (the package on PYTHONPATH as CTest sets it).
     line = next(l for l in section.splitlines() if l.startswith("PYTHONPATH="))
     cmd = line.split(" ", 1)[1]
@@ -224,3 +225,28 @@ def test_a_sweep_equals_the_program(tmp_path, vines_scene):
     assert "vines.beta" in bad["error"][failed] and math.isnan(bad["x_r"][failed])
     with pytest.raises(Exception, match="group_by"):
         vines.sweep(vines_scene, grid={"vines.beta": [1.35]}, group_by="vines.eps")
+
+
+def test_a_loop_stepped_from_python_is_the_run(vines_run, vines_scene):
+    result, _ = vines_run
+    a = vines.samples(vines_scene)
+    assert a.shape == (53761,)  # 53.76 s at 1 kHz, t = 0 first
+    loop = vines.Loop(vines_scene)
+    with pytest.raises(RuntimeError, match="reset"):
+        loop.step(0.0)
+    first = loop.reset(a[0])
+    assert first.t == 0 and first.x.shape == (10,)
+    every = round(vines_scene.sensor_rate_hz / vines_scene.output_rate_hz)
+    for k in range(1, 2001):
+        out = loop.step(a[k])
+        if k % every == 0:
+            np.testing.assert_array_equal(out.x, result.x[k // every])
+    last = loop.run(a[2001:])
+    np.testing.assert_array_equal(last.x, result.x[-1])
+    assert last.particle_x == result.particle_x[-1]
+    totals = loop.totals
+    assert totals["peak_top_displacement_m"] == result.peak_top_displacement_m
+    assert totals["contacts"] == result.contacts and totals["steps"] == 53760
+    # A non-finite sample is held and counted, not propagated.
+    held = loop.step(float("nan"))
+    assert np.all(np.isfinite(held.x)) and loop.totals["bad_samples_held"] == 1

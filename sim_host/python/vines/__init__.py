@@ -6,6 +6,9 @@ program, with scenes, records and results as Python objects and numpy arrays.
     result = vines.run(scene.with_({"vines.beta": 1.5}))
     print(result.x_r, result.E_r, result.x.shape)
 
+Scene, Record, run, sweep, Loop (stepping sample by sample), samples, modal:
+README.md, section "Python".
+
 Every check and message is the command line's: a bad scene raises
 vines.SceneError (a ValueError) naming the key, a bad record
 vines.RecordError naming the file or array.
@@ -18,7 +21,7 @@ import numpy as _np
 from . import _vines
 from ._vines import RecordError, SceneError
 
-__all__ = ["Scene", "Record", "Result", "run", "sweep", "modal", "SceneError", "RecordError"]
+__all__ = ["Scene", "Record", "Result", "Loop", "run", "samples", "sweep", "modal", "SceneError", "RecordError"]
 
 
 class Scene:
@@ -157,6 +160,62 @@ def run(scene, record=None):
     `vines run --record`). With a device the bare frame runs too (x_r, E_r).
     The loop runs with the GIL released."""
     return Result(_vines.run(scene._impl, None if record is None else record._impl))
+
+
+def samples(scene, record=None):
+    """The ground acceleration a run of `scene` steps through [m/s^2]: its
+    record (or `record`) scaled as the scene says and resampled to the sensor
+    rate, sample k at t = k / sensor_rate_hz."""
+    return _vines.samples(scene._impl, None if record is None else record._impl)
+
+
+class Step:
+    """One step's outputs: t, ag; x, v, acc, drift (one value per floor);
+    elastic_energy; particle_x, particle_v, wall_left, wall_right,
+    contact_force, mode (VI NES); tmd_x, tmd_v (TMD). Units as in Series."""
+
+    def __init__(self, d):
+        self.__dict__.update(d)
+
+    def __repr__(self):
+        return "vines.Step(t %.6g s, top floor %.6g m)" % (self.t, self.x[-1])
+
+
+class Loop:
+    """The scene's device run stepped from Python one sample at a time, as a
+    digital twin is fed: the engine `vines run` uses, built once.
+
+        loop = vines.Loop(scene)
+        a = vines.samples(scene)
+        loop.reset(a[0])
+        for a_g in a[1:]:
+            out = loop.step(a_g)      # out.x[-1]: the top floor now
+
+    A non-finite sample is held (the loop's guard, counted in totals)."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self._impl = _vines.Loop(scene._impl)
+
+    def reset(self, a0=0.0):
+        """Back to t = 0 (the scene's initial conditions), ground acceleration a0."""
+        return Step(self._impl.reset(float(a0)))
+
+    def step(self, a_g):
+        """One sensor period to the next sample a_g [m/s^2]; its outputs."""
+        return Step(self._impl.step(float(a_g)))
+
+    def run(self, samples):
+        """Steps through every sample (the loop in C++, the GIL released);
+        the last step's outputs."""
+        return Step(self._impl.run(_np.asarray(samples, dtype=float)))
+
+    @property
+    def totals(self):
+        """Running results: peak_top_displacement_m, t_peak_top_s, per-floor
+        peaks, elastic_energy_integral, contacts, max_overlap_m, steps and
+        the guards' counts."""
+        return self._impl.totals
 
 
 def sweep(scene, grid=None, set=None, cases=None, group_by=None, threads=0):
