@@ -26,7 +26,9 @@ plots=(
 rest=(
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libsundials-dev                                # CVODE baseline (vines bench, tests)
-  pybind11-dev python3-dev python3-pytest        # the Python package and its tests
+  pybind11-dev python3-dev python3-pytest        # the Python package and its tests,
+  python3-venv python3-pip                       # its `pip install .` test,
+  python3-nbclient python3-ipykernel             # the notebook examples/paper.ipynb
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
   clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
