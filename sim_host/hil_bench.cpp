@@ -27,15 +27,13 @@ std::string finite_laws() {
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
 
 // The node: the host's `vines node` or a board in QEMU (its image, scalar and
-// a longer timeout); hybrid mode runs on the host only.
+// a longer timeout).
 void choose_node(Bench* b) {
   HilOptions& o = b->opt;
   const std::string refused = "--node " + o.node + ": must be host, qemu:cortex-m4f or qemu:cortex-m7";
   if (o.node.rfind("qemu:", 0) == 0) {
     b->board = board_of(o.node);
     if (!b->board) throw std::runtime_error(refused);
-    if (o.mode == HilMode::kHybrid)
-      throw std::runtime_error("--node " + o.node + ": hybrid mode runs on the host node only");
     if (o.realtime)
       throw std::runtime_error("--node " + o.node + ": QEMU counts instructions, not wall time: use the virtual clock");
     o.image = board_image(o, *b->board, b->scene);

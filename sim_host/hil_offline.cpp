@@ -9,9 +9,12 @@
 namespace vines::host {
 
 std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what) {
-  if (cfg.mode == link::NodeMode::kHybrid) return {};
   const Scalar scalar = cfg.scalar ? Scalar::kFloat : Scalar::kDouble;
-  return build_engine(cfg.scene, scalar, what)->model_image();
+  if (cfg.mode != link::NodeMode::kHybrid) return build_engine(cfg.scene, scalar, what)->model_image();
+  // Hybrid: the bare frame's modes (the device is on the table).
+  SceneParams bare = cfg.scene;
+  bare.device.kind = DeviceKind::kNone;
+  return hybrid_image(build_engine(bare, Scalar::kDouble, what)->info(), 1.0 / bare.loop.sensor_rate_hz);
 }
 
 std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,

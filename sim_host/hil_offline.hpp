@@ -11,9 +11,9 @@
 
 namespace vines::host {
 
-// The model image of a node's configuration (model_image.hpp): what the
-// bench sends so that no node builds a model. Hybrid nodes build the bare
-// frame themselves (host only) and get none. Errors name `what`.
+// The model image of a node's configuration (model_image.hpp; in hybrid
+// mode the hybrid frame image of the bare frame, link/hybrid_frame.hpp): what
+// the bench sends so that no node builds a model. Errors name `what`.
 std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what);
 
 // The offline run: the scene's engine stepped in this process, read exactly

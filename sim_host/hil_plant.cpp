@@ -1,9 +1,11 @@
 #include "sim_host/hil_plant.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
 #include "sim_host/build_engine.hpp"
+#include "vines/lti.hpp"
 
 namespace vines::host {
 
@@ -18,6 +20,26 @@ link::ModalData modal_data(const ModelInfo& info) {
     for (int i = 0; i < md.n; ++i) md.phi[i][j] = info.mode_shapes[j][i] / info.gamma[j];
   }
   return md;
+}
+
+std::vector<std::uint8_t> hybrid_image(const ModelInfo& info, double h) {
+  const link::ModalData md = modal_data(info);
+  link::ModeStep steps[kMaxStories];
+  for (int j = 0; j < md.n; ++j) {
+    const double w = md.omega[j], z = md.zeta[j];
+    Eigen::Matrix2d a;
+    a << 0, 1, -w * w, -2 * z * w;
+    // The core loop's exact FOH step, with the modal input u as the input.
+    const detail::Foh<2> f = detail::foh<2>(a, Eigen::Vector2d(0, 1), h);
+    for (int r = 0; r < 2; ++r) {
+      for (int c = 0; c < 2; ++c) steps[j].a[r][c] = f.phi(r, c);
+      steps[j].g0[r] = f.g0(r);
+      steps[j].g1[r] = f.g1(r);
+    }
+  }
+  std::vector<std::uint8_t> out(link::hybrid_image_bytes(md.n));
+  out.resize(link::write_hybrid_image(md, steps, h, out.data(), out.size()));
+  return out;
 }
 
 // Far above any model image of the compiled frames (40 stories, double).
@@ -37,33 +59,30 @@ const char* HostPlant::image_push(const std::uint8_t* p, std::size_t n) {
 
 bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap) {
   mode_ = c.mode;
-  SceneParams p = c.scene;
-  if (mode_ == link::NodeMode::kHybrid) p.device.kind = DeviceKind::kNone;  // the device is on the table
-  const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;
-  // Hybrid nodes build the bare frame here; the others load the bench's image.
-  const bool hybrid = mode_ == link::NodeMode::kHybrid;
-  try {
-    engine_ = hybrid ? build_engine(p, scalar, "node") : engine_for(p, scalar, "node");
-  } catch (const EngineError& e) {
-    std::snprintf(msg, cap, "%s", e.reason().c_str());
+  n_ = c.scene.frame.stories;
+  const auto refuse = [&](const std::string& why) {
+    std::snprintf(msg, cap, "%s", why.c_str());
     return false;
-  }
-  if (!hybrid) {
-    if (image_.empty()) {
-      std::snprintf(msg, cap, "no model image: send it before the settings");
-      return false;
-    }
-    const std::string why = engine_->load_image(image_.data(), image_.size());
-    if (!why.empty()) {
-      std::snprintf(msg, cap, "%s", why.c_str());
-      return false;
-    }
-    n_ = p.frame.stories;
+  };
+  if (image_.empty()) return refuse("no model image: send it before the settings");
+  // Hybrid: the bare frame's modes, discretised by the bench (hybrid_frame.hpp).
+  if (mode_ == link::NodeMode::kHybrid) {
+    if (!link::is_hybrid_image(image_.data(), image_.size()))
+      return refuse("mode hybrid: the model image is not a hybrid frame image");
+    if (const char* why = hybrid_.load(image_.data(), image_.size(), kMaxStories)) return refuse(why);
+    if (hybrid_.stories() != n_) return refuse("frame.stories: differs from the hybrid frame image's");
+    if (!(std::fabs(hybrid_.period() * c.scene.loop.sensor_rate_hz - 1.0) <= 1e-12))
+      return refuse("loop.sensor_rate_hz: differs from the hybrid frame image's");
     return true;
   }
-  n_ = p.frame.stories;
-  hybrid_.setup(modal_data(engine_->info()), 1.0 / p.loop.sensor_rate_hz);
-  return true;
+  const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;
+  try {
+    engine_ = engine_for(c.scene, scalar, "node");
+  } catch (const EngineError& e) {
+    return refuse(e.reason());
+  }
+  const std::string why = engine_->load_image(image_.data(), image_.size());
+  return why.empty() || refuse(why);
 }
 
 void HostPlant::init(double a0, double f0) {

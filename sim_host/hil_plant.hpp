@@ -17,10 +17,13 @@ namespace vines::host {
 // The modal data of a bare frame, from a built engine's model info.
 link::ModalData modal_data(const ModelInfo& info);
 
-// The model image (model_image.hpp) is collected as it arrives and loaded
-// into the scene's engine at configure: the host node, like a board, runs
-// the model the bench built. Hybrid mode builds the bare frame from the
-// scene (it needs its modes) and takes no image.
+// The hybrid frame image (link/hybrid_frame.hpp) of the bare frame's modes
+// at period h: what a hybrid node runs.
+std::vector<std::uint8_t> hybrid_image(const ModelInfo& info, double h);
+
+// The model image (model_image.hpp, or in hybrid mode the hybrid frame
+// image) is collected as it arrives and loaded at configure: the host node,
+// like a board, runs the model the bench built.
 class HostPlant {
  public:
   const char* image_begin(std::uint32_t total);

@@ -136,8 +136,9 @@ class Stream {
     // may be under way at once without changing what it computes. A board in
     // QEMU takes a byte per turn of QEMU's loop: a window of frames keeps its
     // UART busy; the host node runs in strict lock step (its latency is
-    // measured per sample).
-    if (!o_.realtime) node_->wait_answered(b_.board ? 16 : 0);
+    // measured per sample), and so does hybrid mode: the lab moves the table
+    // by the command of the step before, which must be there.
+    if (!o_.realtime) node_->wait_answered(b_.board && o_.mode != HilMode::kHybrid ? 16 : 0);
   }
 
   // Sample k sent now, dropped, corrupted, duplicated or held for a reorder.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "firmware/app/node_app.hpp"
+#include "sim_host/build_engine.hpp"
 #include "sim_host/hil_plant.hpp"
 #include "support.hpp"
 #include "vines/link/model_plant.hpp"
@@ -71,10 +72,11 @@ struct Bench {
     blob.resize(link::encode(c, blob.data(), blob.size()));
     part(link::ConfigPart::kSettings, blob);
   }
-  void run(const std::vector<double>& a) {
+  // Samples a[k], with the measured force f[k] in hybrid mode (none: 0).
+  void run(const std::vector<double>& a, const std::vector<double>& f = {}) {
     send(link::MsgType::kStart, link::Start{0, 0});
     for (std::size_t k = 0; k < a.size(); ++k)
-      send(link::MsgType::kSample, link::Sample{static_cast<std::uint32_t>(k), 0, a[k], 0.0});
+      send(link::MsgType::kSample, link::Sample{static_cast<std::uint32_t>(k), 0, a[k], f.empty() ? 0.0 : f[k]});
     send(link::MsgType::kStop, nullptr, 0);
   }
 };
@@ -86,6 +88,13 @@ std::vector<std::uint8_t> image_of(const SceneParams& p) {
   std::vector<std::uint8_t> out(image::image_bytes<double, 10, Dev>());
   EXPECT_EQ(image::write_image(*m, out.data(), out.size()), out.size());
   return out;
+}
+
+// The hybrid frame image the bench sends (sim_host/hil_offline.cpp): the
+// bare frame's modes of scene p at its sensor rate.
+std::vector<std::uint8_t> hybrid_image_of(SceneParams p) {
+  p.device.kind = DeviceKind::kNone;
+  return host::hybrid_image(host::build_engine(p, host::Scalar::kDouble, "test")->info(), 1.0 / p.loop.sensor_rate_hz);
 }
 
 link::NodeConfig config_of(const SceneParams& p) {
@@ -215,13 +224,112 @@ TEST(NodeApp, AnImageOfAnotherDeviceOrSettingsThatDoNotFitAreRefused) {
   hybrid.mode = link::NodeMode::kHybrid;
   r.bench.settings(hybrid);
   EXPECT_EQ(r.out.status.state, link::NodeState::kBooted);
-  EXPECT_NE(std::string(r.out.status.message).find("hybrid"), std::string::npos);
+  EXPECT_STREQ(r.out.status.message, "mode hybrid: send a hybrid frame image before the settings");
   link::NodeConfig as_float = config_of(p);
   as_float.scalar = 1;
   r.bench.settings(as_float);
   EXPECT_STREQ(r.out.status.message, "scalar: this node runs double");
   r.bench.settings(config_of(p));
   EXPECT_EQ(r.out.status.state, link::NodeState::kConfigured) << r.out.status.message;
+}
+
+// Hybrid mode on the board: the bare frame's modes arrive as the hybrid
+// frame image, and the board steps them with the table's force as the host
+// node does; with no force the frame is the bare frame of the core loop.
+TEST(NodeApp, BoardNodeRunsTheHybridFrameAsTheHostNode) {
+  const SceneParams p = paper_scene(DeviceKind::kVines);
+  std::vector<double> a = elcentro(1000.0);
+  a.resize(5000);
+  std::vector<double> f(a.size());
+  for (std::size_t k = 0; k < f.size(); ++k) f[k] = 2e5 * std::sin(7.0 * 1e-3 * static_cast<double>(k));
+  link::NodeConfig c = config_of(p);
+  c.mode = link::NodeMode::kHybrid;
+  const std::vector<std::uint8_t> img = hybrid_image_of(p);
+  ASSERT_EQ(img.size(), link::hybrid_image_bytes(10));
+  BoardNode b;
+  b.bench.part(link::ConfigPart::kModelImage, img);
+  b.bench.settings(c);
+  ASSERT_EQ(b.out.status.state, link::NodeState::kConfigured) << b.out.status.message;
+  b.bench.run(a, f);
+  ASSERT_EQ(b.out.tel.size(), a.size());
+
+  host::HostPlant host;
+  host.image_begin(static_cast<std::uint32_t>(img.size()));
+  host.image_push(img.data(), img.size());
+  char msg[80] = {};
+  ASSERT_TRUE(host.configure(c, msg, sizeof msg)) << msg;
+  double worst = 0, peak = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    link::Telemetry t;
+    if (k == 0) host.init(a[0], f[0]);
+    else host.step(a[k], f[k]);
+    host.read(&t);
+    for (int i = 0; i < 10; ++i) worst = std::fmax(worst, std::fabs(b.out.tel[k].x[i] - t.x[i]));
+    peak = std::fmax(peak, std::fabs(t.x[9]));
+  }
+  EXPECT_GT(peak, 0.01);
+  EXPECT_LE(worst, 1e-12 * peak) << "peak " << peak;
+
+  // No force: the modal hybrid frame against the core's bare frame (the
+  // exact step in physical coordinates), an independent discretisation.
+  BoardNode z;
+  z.bench.part(link::ConfigPart::kModelImage, img);
+  z.bench.settings(c);
+  z.bench.run(a);
+  SceneParams bare = p;
+  bare.device.kind = DeviceKind::kNone;
+  const std::vector<std::uint8_t> bare_img = image_of<NoDevice>(bare);
+  host::HostPlant ref;
+  ref.image_begin(static_cast<std::uint32_t>(bare_img.size()));
+  ref.image_push(bare_img.data(), bare_img.size());
+  ASSERT_TRUE(ref.configure(config_of(bare), msg, sizeof msg)) << msg;
+  worst = peak = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    link::Telemetry t;
+    if (k == 0) ref.init(a[0], 0);
+    else ref.step(a[k], 0);
+    ref.read(&t);
+    for (int i = 0; i < 10; ++i) worst = std::fmax(worst, std::fabs(z.out.tel[k].x[i] - t.x[i]));
+    peak = std::fmax(peak, std::fabs(t.x[9]));
+  }
+  EXPECT_GT(peak, 0.05);
+  EXPECT_LE(worst, 1e-9 * peak) << "peak " << peak;
+}
+
+TEST(NodeApp, AHybridFrameImageIsCheckedWhole) {
+  const SceneParams p = paper_scene(DeviceKind::kVines);
+  const std::vector<std::uint8_t> good = hybrid_image_of(p);
+  link::NodeConfig c = config_of(p);
+  c.mode = link::NodeMode::kHybrid;
+  const auto refused = [&](const std::vector<std::uint8_t>& img, const std::string& why) {
+    BoardNode b;
+    b.bench.part(link::ConfigPart::kModelImage, img);
+    EXPECT_NE(std::string(b.out.status.message).find(why), std::string::npos) << b.out.status.message;
+    b.bench.settings(c);
+    EXPECT_EQ(b.out.status.state, link::NodeState::kBooted);
+  };
+  std::vector<std::uint8_t> nan = good;
+  const double bad = std::nan("");
+  std::memcpy(nan.data() + 16 + 8 * 3, &bad, 8);  // mode 1's a00
+  refused(nan, "not finite");
+  refused(std::vector<std::uint8_t>(good.begin(), good.end() - 8), "length");
+  std::vector<std::uint8_t> version = good;
+  version[4] = 9;
+  refused(version, "version");
+  link::ModalData tall;  // 11 modes of some frame: more than the board's 10
+  tall.n = 11;
+  link::ModeStep steps[11];
+  std::vector<std::uint8_t> eleven(link::hybrid_image_bytes(11));
+  ASSERT_EQ(link::write_hybrid_image(tall, steps, 1e-3, eleven.data(), eleven.size()), eleven.size());
+  refused(eleven, "more stories");
+  // A good image of another rate does not fit the settings.
+  SceneParams other = p;
+  other.loop.sensor_rate_hz = 2048.0;
+  BoardNode b;
+  b.bench.part(link::ConfigPart::kModelImage, hybrid_image_of(other));
+  ASSERT_STREQ(b.out.status.message, "");
+  b.bench.settings(c);
+  EXPECT_STREQ(b.out.status.message, "loop.sensor_rate_hz: differs from the hybrid frame image's");
 }
 
 }  // namespace

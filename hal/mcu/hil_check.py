@@ -3,7 +3,8 @@
 QEMU and checks its report; exit 0 if every check holds, 1 with the reasons.
 
   hil_check.py [--max-deviation M] [--all-faults] [--expect-overruns]
-               [--no-overruns] [--expect-refusal TEXT] -- VINES hil ARGS...
+               [--no-overruns] [--expect-refusal TEXT] [--hybrid-as-host M]
+               -- VINES hil ARGS...
 
 --max-deviation M   every step arrived, outputs finite, and no floor more than
                     M metres from the host's offline run of the same scalar
@@ -14,6 +15,9 @@ QEMU and checks its report; exit 0 if every check holds, 1 with the reasons.
 --no-overruns       no step's ticks exceed the budget (the node's count and the
                     telemetry's both zero)
 --expect-refusal T  the command fails (exit 1) with T in its message
+--hybrid-as-host M  hybrid mode: the same command on the host node (without
+                    --node and --image) gives the same table tracking and
+                    top-floor response, within M metres
 Always: the report names the board node and its worst step's instructions.
 Standard library only."""
 import json
@@ -29,7 +33,7 @@ def main(argv):
         sys.exit(__doc__)
     cut = argv.index("--")
     opts, cmd = argv[1:cut], argv[cut + 1:]
-    max_dev = refusal = None
+    max_dev = refusal = as_host = None
     all_faults = overruns = no_overruns = False
     i = 0
     while i < len(opts):
@@ -37,6 +41,8 @@ def main(argv):
             max_dev = float(opts[i + 1]); i += 2
         elif opts[i] == "--expect-refusal":
             refusal = opts[i + 1]; i += 2
+        elif opts[i] == "--hybrid-as-host":
+            as_host = float(opts[i + 1]); i += 2
         elif opts[i] == "--all-faults":
             all_faults = True; i += 1
         elif opts[i] == "--expect-overruns":
@@ -91,9 +97,36 @@ def main(argv):
         if nd["overruns"] != 0 or j["steps_over_budget"] != 0:
             problems.append(f"{nd['overruns']} steps overran the budget of {nd['budget_ticks']} ticks "
                             f"(telemetry: {j['steps_over_budget']}), worst {nd['worst_ticks']} at k {nd['worst_k']}")
+    if as_host is not None:
+        problems += compare_hybrid(cmd, j, as_host)
     for m in problems:
         print("FAIL:", m)
     return 1 if problems else 0
+
+
+def compare_hybrid(cmd, board, tol):
+    """The board's hybrid report against the host node's on the same command."""
+    host_cmd, skip = [], False
+    for a in cmd:
+        if skip:
+            skip = False
+        elif a in ("--node", "--image"):
+            skip = True
+        elif not a.startswith("--node=") and not a.startswith("--image="):
+            host_cmd.append(a)
+    p = subprocess.run(host_cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        return [f"host run failed (exit {p.returncode}): {p.stderr.strip()}"]
+    host = json.loads(p.stdout)
+    if "hybrid" not in board or "hybrid" not in host:
+        return ["no hybrid report"]
+    problems = []
+    for key in ("tracking_rms_m", "tracking_peak_m", "peak_top_hybrid_m", "top_diff_from_pure_rms_m"):
+        b, h = board["hybrid"][key], host["hybrid"][key]
+        print(f"hybrid {key}: board {b:.6g}, host {h:.6g}")
+        if not abs(b - h) <= tol:
+            problems.append(f"hybrid {key}: board {b:.6g} m, host {h:.6g} m (more than {tol:g} m apart)")
+    return problems
 
 
 if __name__ == "__main__":

@@ -1,16 +1,19 @@
 // The plant of a board's node (link/node.hpp): one compiled instance of the
 // core (scalar S, N stories, device Dev) whose model arrives as the image the
-// host built (model_image.hpp), decoded straight into static storage. The
-// board never builds a model: no eigensolver, no matrix exponential. Replay
-// and twin modes; hybrid mode (the bare frame driven by a table force) runs
-// on the host node.
+// host built (model_image.hpp), decoded straight into static storage, for
+// replay and twin modes; in hybrid mode the bare frame driven by the table's
+// force (link/hybrid_frame.hpp), whose discretised modes arrive as the hybrid
+// frame image instead. The board never builds a model: no eigensolver, no
+// matrix exponential.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "vines/link/config.hpp"
+#include "vines/link/hybrid_frame.hpp"
 #include "vines/link/messages.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
@@ -26,13 +29,34 @@ class ModelPlant {
   // model and data: static storage of the application (they are large).
   ModelPlant(ModelT* model, DataT* data) : model_(model), data_(data), loader_(model) {}
 
-  const char* image_begin(std::uint32_t /*total*/) {
+  // The image: a core model image, streamed into the model; or a hybrid
+  // frame image (told by its magic), gathered and then loaded.
+  const char* image_begin(std::uint32_t total) {
     configured_ = false;
+    hybrid_ready_ = false;
     loader_.reset();
+    image_total_ = total;
+    image_len_ = 0;
     return nullptr;
   }
-  const char* image_push(const std::uint8_t* p, std::size_t n) { return loader_.push(p, n); }
-  const char* image_finish() { return loader_.finish(); }
+  const char* image_push(const std::uint8_t* p, std::size_t n) {
+    if (image_len_ == 0) hybrid_image_ = is_hybrid_image(p, n);
+    if (!hybrid_image_) {
+      image_len_ += n;
+      return loader_.push(p, n);
+    }
+    if (image_total_ > sizeof hybrid_buf_ || n > sizeof hybrid_buf_ - image_len_)
+      return "hybrid frame image: more stories than this board holds";
+    std::memcpy(hybrid_buf_ + image_len_, p, n);
+    image_len_ += n;
+    return nullptr;
+  }
+  const char* image_finish() {
+    if (!hybrid_image_) return loader_.finish();
+    const char* why = hybrid_.load(hybrid_buf_, image_len_, N);
+    hybrid_ready_ = why == nullptr;
+    return why;
+  }
 
   // The settings must fit the image this node holds.
   bool configure(const NodeConfig& c, char* msg, std::size_t cap) {
@@ -43,19 +67,31 @@ class ModelPlant {
       return false;
     }
     configured_ = true;
+    hybrid_mode_ = c.mode == NodeMode::kHybrid;
     guard_events_ = 0;
     return true;
   }
 
-  void init(double a0, double /*f0*/) {
+  void init(double a0, double f0) {
     guard_events_ = 0;
-    vines::init(*model_, *data_, static_cast<S>(a0));
+    if (hybrid_mode_) hybrid_.init(a0, f0);
+    else vines::init(*model_, *data_, static_cast<S>(a0));
   }
-  void step(double a1, double /*f1*/) { vines::step(*model_, *data_, static_cast<S>(a1)); }
+  void step(double a1, double f1) {
+    if (hybrid_mode_) hybrid_.step(a1, f1);
+    else vines::step(*model_, *data_, static_cast<S>(a1));
+  }
 
   // What the host node's plant reads (sim_host/hil_plant.cpp), from the same
   // core functions.
   void read(Telemetry* t) {
+    if (hybrid_mode_) {
+      t->n = static_cast<std::uint8_t>(N);
+      for (int i = 0; i < N; ++i) t->x[i] = hybrid_.x(i);
+      t->acc_top = hybrid_.abs_acc(N - 1);
+      t->elastic_energy = hybrid_.elastic_energy();
+      return;
+    }
     const ModelT& m = *model_;
     const DataT& d = *data_;
     const auto x = floor_displacements(m, d);
@@ -80,10 +116,16 @@ class ModelPlant {
 
  private:
   const char* check(const NodeConfig& c) const {
-    if (c.mode == NodeMode::kHybrid) return "mode hybrid: runs on the host node (vines node), not on this board";
-    if (!loader_.ready()) return "no model image: send it before the settings";
     if (c.scalar != (sizeof(S) == 4 ? 1 : 0))
       return sizeof(S) == 4 ? "scalar: this node runs float" : "scalar: this node runs double";
+    if (c.mode == NodeMode::kHybrid) {
+      if (!hybrid_ready_) return "mode hybrid: send a hybrid frame image before the settings";
+      if (c.scene.frame.stories != N || hybrid_.stories() != N) return "frame.stories: differs from this board's";
+      if (!(std::fabs(hybrid_.period() * c.scene.loop.sensor_rate_hz - 1.0) <= 1e-12))
+        return "loop.sensor_rate_hz: differs from the hybrid frame image's";
+      return nullptr;
+    }
+    if (!loader_.ready()) return "no model image: send it before the settings";
     if (c.scene.frame.stories != N) return "frame.stories: differs from the model image's";
     if (c.scene.device.kind != Dev::kKind) return "device.kind: differs from the model image's";
     if constexpr (Dev::kKind == DeviceKind::kVines) {
@@ -108,6 +150,10 @@ class ModelPlant {
   ModelT* model_;
   DataT* data_;
   image::Loader<S, N, Dev> loader_;
+  HybridFrame<S> hybrid_;
+  std::uint8_t hybrid_buf_[hybrid_image_bytes(N)] = {};
+  std::size_t image_total_ = 0, image_len_ = 0;
+  bool hybrid_image_ = false, hybrid_ready_ = false, hybrid_mode_ = false;
   bool configured_ = false;
   std::int64_t guard_events_ = 0;
 };
