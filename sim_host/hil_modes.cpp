@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/hil_lab.hpp"
 #include "sim_host/hil_offline.hpp"
+#include "sim_host/rths_criteria.hpp"
 
 namespace vines::host {
 namespace {
@@ -116,7 +118,35 @@ class HybridMode : public BenchMode {
     hy.force_noise_n = o.force_noise_n, hy.force_lsb_n = o.force_lsb_n;
     hy.tracking_rms_m = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
     hy.top_diff_from_pure_rms_m = used ? std::sqrt(dss / static_cast<double>(used)) : 0.0;
+    criteria(rec, offline, &hy);
     r->hybrid = hy;
+  }
+
+  // The vRTHS benchmark's criteria (rths_criteria.hpp) on the whole run: the
+  // table against the frame's top floor (the target before compensation),
+  // each floor against the pure simulation. A step without telemetry holds
+  // the node's last one.
+  void criteria(const HilRecord& rec, const std::vector<Telemetry>& offline, HilHybridReport* hy) const {
+    const int n = b_.scene.params.frame.stories;
+    const auto K = static_cast<std::size_t>(rec.samples);
+    std::vector<std::vector<double>> hybrid(static_cast<std::size_t>(n), std::vector<double>(K)),
+        pure(static_cast<std::size_t>(n), std::vector<double>(K));
+    const Telemetry* last = &offline[0];
+    for (std::size_t k = 0; k < K; ++k) {
+      if (rec.got[k]) last = &rec.tel[k];
+      for (int i = 0; i < n; ++i) hybrid[i][k] = last->x[i], pure[i][k] = offline[k].x[i];
+    }
+    const std::vector<double>& target = hybrid[static_cast<std::size_t>(n - 1)];
+    if (K >= 3) {
+      const std::optional<double> d = rths::tracking_delay_s(target, rec.table_x, b_.h, std::max(0.1, 2 * b_.h));
+      if (d) hy->tracking_delay_ms = 1e3 * *d;
+    }
+    hy->tracking_rms_pct = rths::rms_error_pct(target, rec.table_x);
+    hy->tracking_peak_pct = rths::peak_error_pct(target, rec.table_x);
+    for (int i = 0; i < n; ++i) {
+      hy->response_rms_pct.push_back(rths::rms_error_pct(pure[i], hybrid[i]));
+      hy->response_peak_pct.push_back(rths::peak_error_pct(pure[i], hybrid[i]));
+    }
   }
 
  private:

@@ -17,6 +17,12 @@ json to_json(const std::optional<HilStats>& s) {
 
 json to_json(const std::optional<double>& x) { return x ? json(*x) : json(nullptr); }
 
+json to_json(const std::vector<std::optional<double>>& xs) {
+  json a = json::array();
+  for (const auto& x : xs) a.push_back(to_json(x));
+  return a;
+}
+
 json to_json(const HilTwinReport& t) {
   return {{"truth_stiffness_scale", t.truth_stiffness_scale},
           {"residual_rms_mps2", t.residual_rms_mps2},
@@ -41,7 +47,12 @@ json to_json(const HilHybridReport& h) {
           {"top_diff_from_pure_rms_m", h.top_diff_from_pure_rms_m},
           {"top_diff_from_pure_peak_m", h.top_diff_from_pure_peak_m},
           {"peak_top_hybrid_m", h.peak_top_hybrid_m},
-          {"peak_top_pure_m", h.peak_top_pure_m}};
+          {"peak_top_pure_m", h.peak_top_pure_m},
+          {"tracking_delay_ms", to_json(h.tracking_delay_ms)},
+          {"tracking_rms_pct", to_json(h.tracking_rms_pct)},
+          {"tracking_peak_pct", to_json(h.tracking_peak_pct)},
+          {"response_rms_pct", to_json(h.response_rms_pct)},
+          {"response_peak_pct", to_json(h.response_peak_pct)}};
 }
 
 }  // namespace

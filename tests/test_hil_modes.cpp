@@ -3,6 +3,7 @@
 // without delay compensation, and a configuration the node must refuse.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -86,6 +87,15 @@ TEST(HilHybrid, CompensationReducesTrackingError) {
   EXPECT_GT(ha.compensation_delay_s, 0.005);
   EXPECT_LT(ha.tracking_rms_m, 0.2 * hb.tracking_rms_m);
   EXPECT_LT(ha.tracking_peak_m, hb.tracking_peak_m);
+  // The vRTHS criteria: uncompensated, the table lags by the servo's delay
+  // (5 ms), its lag 2 zeta / w (11.14 ms) and half a period of the command's
+  // hold (0.5 ms); compensated, by under a millisecond. Each floor is judged.
+  ASSERT_TRUE(ha.tracking_delay_ms && hb.tracking_delay_ms);
+  EXPECT_NEAR(*hb.tracking_delay_ms, 5 + 1e3 * 2 * 0.7 / (2 * M_PI * 20) + 0.5, 0.3);
+  EXPECT_LT(std::fabs(*ha.tracking_delay_ms), 1.0);
+  EXPECT_LT(*ha.tracking_rms_pct, 0.2 * *hb.tracking_rms_pct);
+  EXPECT_EQ(ha.response_rms_pct.size(), 10u);
+  EXPECT_EQ(ha.response_peak_pct.size(), 10u);
   for (const HilReport* r : {&a, &b}) {
     EXPECT_TRUE(r->outputs_finite);
     EXPECT_LT(r->hybrid->peak_top_hybrid_m, 2 * r->hybrid->peak_top_pure_m);

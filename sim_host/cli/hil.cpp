@@ -5,6 +5,8 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,13 @@
 
 namespace vines::cli {
 namespace {
+
+// printf into a string.
+std::string format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
 
 struct HilArgs {
   std::string scene_path;
@@ -70,6 +79,16 @@ void print_hil(const host::HilReport& r) {
                 1e3 * hy.compensation_delay_s, hy.compensation_order, 1e3 * hy.tracking_rms_m,
                 1e3 * hy.tracking_peak_m, 1e3 * hy.top_diff_from_pure_rms_m, 1e3 * hy.top_diff_from_pure_peak_m,
                 hy.peak_top_hybrid_m, hy.peak_top_pure_m);
+    // The vRTHS benchmark's criteria (docs/rths_criteria.md); "n/a": no scale or beyond the search.
+    auto pct = [](const std::optional<double>& v) { return v ? format("%.3g", *v) : std::string("n/a"); };
+    std::printf("  vRTHS criteria: tracking delay %s ms, RMS %s %%, peak %s %%\n",
+                hy.tracking_delay_ms ? format("%.3f", *hy.tracking_delay_ms).c_str() : "n/a",
+                pct(hy.tracking_rms_pct).c_str(), pct(hy.tracking_peak_pct).c_str());
+    for (const auto& [name, v] : {std::pair{"RMS", &hy.response_rms_pct}, std::pair{"peak", &hy.response_peak_pct}}) {
+      std::printf("    response %-4s %% by floor (bottom first):", name);
+      for (const std::optional<double>& x : *v) std::printf(" %s", pct(x).c_str());
+      std::printf("\n");
+    }
   }
 }
 
