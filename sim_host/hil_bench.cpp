@@ -24,6 +24,21 @@ std::string finite_laws() {
   return out;
 }
 
+// The scene's device as the hybrid mode's specimen: a TMD or a VI NES of a
+// finite-duration law, on the top floor (the table plays it).
+void check_specimen(const Scene& sc) {
+  const DeviceParams& d = sc.params.device;
+  const int n = sc.params.frame.stories;
+  if (d.kind == DeviceKind::kNone)
+    throw std::runtime_error(sc.path + ": --mode hybrid needs a device on the table (device.kind tmd or vines)");
+  if (d.kind == DeviceKind::kVines && law_impulsive(d.vines.law))
+    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law (" +
+                             finite_laws() + "): the table's load cell measures contact forces");
+  if (d.floor != 0 && d.floor != n)
+    throw std::runtime_error(sc.path + ": --mode hybrid: device.floor " + std::to_string(d.floor) +
+                             ": the table plays the top floor (0 or " + std::to_string(n) + ")");
+}
+
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
 
 // The node: the host's `vines node` or a board in QEMU (its image, scalar and
@@ -77,13 +92,12 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   b.ex = load_excitation(sc, "");
   b.samples = static_cast<long long>(b.ex.samples.size());
   b.h = 1.0 / sc.params.loop.sensor_rate_hz;
-  // Hybrid: the table's load cell measures contact forces, and the command
-  // is compensated by default for the actuator's delay and lag (2 zeta / w).
+  // Hybrid: the table carries the device and plays the top floor; its load
+  // cell measures forces (a VI NES's contacts must last), and the command is
+  // compensated by default for the actuator's delay and lag (2 zeta / w).
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
-  if (hybrid && (sc.params.device.kind != DeviceKind::kVines || law_impulsive(sc.params.device.vines.law)))
-    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law (" +
-                             finite_laws() + "): the table's load cell measures contact forces");
+  if (hybrid) check_specimen(sc);
   if (hybrid && o.comp_delay_s < 0) o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz);
   if (o.comp_delay_s < 0) o.comp_delay_s = 0;
   b.cfg = node_config(sc, o);

@@ -71,8 +71,8 @@ class TwinMode : public BenchMode {
 };
 
 // Hybrid: the node's bare frame commands the table (its top floor's motion);
-// the lab moves the table with the VI NES on it, and the load cell's force
-// goes back to the node.
+// the lab moves the table with the scene's device on it (VI NES or TMD), and
+// the load cell's force goes back to the node.
 class HybridMode : public BenchMode {
  public:
   HybridMode(const Bench& b, const Telemetry& initial) : b_(b) {
@@ -80,8 +80,18 @@ class HybridMode : public BenchMode {
     const std::unique_ptr<Engine> eng = build_engine(sc.params, sc.scalar, sc.path);
     const HilOptions& o = b.opt;
     const LabOptions lo{o.actuator_hz, o.actuator_zeta, o.actuator_delay_s, o.force_noise_n, o.force_lsb_n, o.seed};
-    lab_ = std::make_unique<ShakeTable>(eng->info().vines, sc.params.device.vines.law, initial.particle_x,
-                                        initial.particle_v, b.h, lo);
+    // The specimen where the pure simulation starts it: the VI NES particle
+    // as the offline run reads it, the TMD at its initial conditions
+    // (relative to the top floor, at rest at 0 like the table).
+    Specimen sp;
+    sp.kind = sc.params.device.kind;
+    sp.vines = eng->info().vines;
+    sp.law = sc.params.device.vines.law;
+    sp.tmd = eng->info().tmd;
+    const TmdParams& tp = sc.params.device.tmd;
+    sp.x0 = sp.kind == DeviceKind::kTmd ? tp.initial_position_m : initial.particle_x;
+    sp.v0 = sp.kind == DeviceKind::kTmd ? tp.initial_velocity_mps : initial.particle_v;
+    lab_ = std::make_unique<ShakeTable>(sp, b.h, lo);
   }
 
   // The table follows the last command received; the load cell reads the

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include "sim_host/hil.hpp"
@@ -117,9 +118,59 @@ TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
   EXPECT_NEAR(hy.peak_top_hybrid_m, hy.peak_top_pure_m, 0.05 * hy.peak_top_pure_m) << to_json(r)["hybrid"].dump();
 }
 
-TEST(HilHybrid, RefusesAnInstantaneousLaw) {
-  Scene sc = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines_restitution.toml");
-  EXPECT_THROW(run_hil(sc, base(HilMode::kHybrid, 1.0)), std::runtime_error);
+// A linear specimen (the TMD): the hybrid response converges to the pure
+// simulation as the tracking error shrinks. Uncompensated (the default
+// actuator: 16.6 ms behind), compensated (order 2 over the default delay),
+// and ideal (the same 20 Hz servo without delay or load-cell noise,
+// compensated for its lag 2 zeta / w and the command's hold h / 2): both the
+// tracking and the top floor's RMS error fall at each, compensated within the
+// issue's 2 %. (A 2 kHz servo would follow the held command in steps, its
+// velocity zero at each sample: the load cell then misses the dashpot's
+// force and the response is 8 % off; a smooth servo is the ideal here.)
+TEST(HilHybrid, TmdSpecimenConvergesToThePureSimulation) {
+  const Scene tmd = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_tmd.toml");
+  HilOptions unc = base(HilMode::kHybrid, 0), comp = base(HilMode::kHybrid, 0), ideal = base(HilMode::kHybrid, 0);
+  unc.comp_delay_s = 0;
+  ideal.actuator_delay_s = 0;
+  ideal.force_noise_n = ideal.force_lsb_n = 0;
+  ideal.comp_delay_s = 2 * 0.7 / (2 * M_PI * 20) + 0.5e-3;
+  double last_tracking = 1e9, last_response = 1e9;
+  for (const HilOptions* o : {&unc, &comp, &ideal}) {
+    const HilReport r = run_hil(tmd, *o);
+    ASSERT_TRUE(r.hybrid && r.outputs_finite);
+    const HilHybridReport& hy = *r.hybrid;
+    SCOPED_TRACE(to_json(r)["hybrid"].dump());
+    ASSERT_TRUE(hy.tracking_rms_pct && hy.response_rms_pct.size() == 10u && hy.response_rms_pct[9]);
+    EXPECT_LT(*hy.tracking_rms_pct, last_tracking);
+    EXPECT_LT(*hy.response_rms_pct[9], last_response);
+    last_tracking = *hy.tracking_rms_pct, last_response = *hy.response_rms_pct[9];
+    if (o == &comp)
+      for (const std::optional<double>& v : hy.response_rms_pct) EXPECT_LE(*v, 2.0);
+  }
+  EXPECT_LT(last_response, 0.05);  // ideal: a twentieth of a percent
+}
+
+// What the table cannot carry, each refused naming the scene and the key: an
+// instantaneous contact law (no force for a load cell), no device, a device
+// below the top floor (the table plays the top floor).
+TEST(HilHybrid, RefusesWhatTheTableCannotCarry) {
+  const std::string dir = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+  auto refusal = [](const Scene& sc) {
+    try {
+      run_hil(sc, base(HilMode::kHybrid, 1.0));
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(not refused)");
+  };
+  EXPECT_NE(refusal(load_scene(dir + "elcentro_vines_restitution.toml")).find("finite-duration contact law"),
+            std::string::npos);
+  EXPECT_NE(refusal(load_scene(dir + "elcentro_bare.toml")).find("device.kind"), std::string::npos);
+  Scene low = load_scene(dir + "elcentro_tmd.toml");
+  low.params.device.floor = 3;
+  const std::string why = refusal(low);
+  EXPECT_NE(why.find("elcentro_tmd.toml"), std::string::npos) << why;
+  EXPECT_NE(why.find("device.floor 3"), std::string::npos) << why;
 }
 
 // A node given a frame with a NaN mass refuses it and names the field.
