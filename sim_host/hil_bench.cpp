@@ -94,11 +94,13 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   b.h = 1.0 / sc.params.loop.sensor_rate_hz;
   // Hybrid: the table carries the device and plays the top floor; its load
   // cell measures forces (a VI NES's contacts must last), and the command is
-  // compensated by default for the actuator's delay and lag (2 zeta / w).
+  // compensated by default for the actuator's delay, its lag (2 zeta / w)
+  // and the command's hold over a period (h / 2).
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
   if (hybrid) check_specimen(sc);
-  if (hybrid && o.comp_delay_s < 0) o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz);
+  if (hybrid && o.comp_delay_s < 0)
+    o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz) + 0.5 * b.h;
   if (o.comp_delay_s < 0) o.comp_delay_s = 0;
   b.cfg = node_config(sc, o);
   b.image = model_image(b.cfg, sc.path);

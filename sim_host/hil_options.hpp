@@ -52,7 +52,7 @@ struct HilOptions {
   // hybrid
   double actuator_hz = 20, actuator_zeta = 0.7, actuator_delay_s = 0.005;
   double force_noise_n = 50, force_lsb_n = 10;
-  double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
+  double comp_delay_s = -1;  // < 0: the actuator's delay, its lag (2 zeta / w) and the hold's h / 2
   int comp_order = 2;
   // The node: "host" (this program's `vines node`), "qemu:cortex-m4f" or
   // "qemu:cortex-m7" (the board image in QEMU, instructions counted), or the

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "sim_host/hil.hpp"
 #include "sim_host/hil_child.hpp"
@@ -119,35 +120,48 @@ TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
 }
 
 // A linear specimen (the TMD): the hybrid response converges to the pure
-// simulation as the tracking error shrinks. Uncompensated (the default
-// actuator: 16.6 ms behind), compensated (order 2 over the default delay),
-// and ideal (the same 20 Hz servo without delay or load-cell noise,
-// compensated for its lag 2 zeta / w and the command's hold h / 2): both the
-// tracking and the top floor's RMS error fall at each, compensated within the
-// issue's 2 %. (A 2 kHz servo would follow the held command in steps, its
-// velocity zero at each sample: the load cell then misses the dashpot's
-// force and the response is 8 % off; a smooth servo is the ideal here.)
+// simulation as the tracking error shrinks. On the default actuator (16.6 ms
+// behind): uncompensated, compensated for the pure delay and the hold only
+// (5.5 ms), then for the servo's lag too (16.6 ms) by order 1 and order 2:
+// the tracking and the top floor's RMS error fall at each, within the
+// issue's 2 % once compensated. The ideal (the same 20 Hz servo without
+// delay or load-cell noise, compensated for its lag 2 zeta / w and the hold
+// h / 2) and order 2 meet at the floor the held command leaves (about 0.01 %).
+// (A 2 kHz servo would follow the held command in steps, its velocity zero at
+// each sample: the load cell then misses the dashpot's force and the response
+// is 8 % off; a smooth servo is the ideal here.)
 TEST(HilHybrid, TmdSpecimenConvergesToThePureSimulation) {
   const Scene tmd = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_tmd.toml");
-  HilOptions unc = base(HilMode::kHybrid, 0), comp = base(HilMode::kHybrid, 0), ideal = base(HilMode::kHybrid, 0);
-  unc.comp_delay_s = 0;
+  const double lag = 2 * 0.7 / (2 * M_PI * 20), hold = 0.5e-3;
+  std::vector<HilOptions> runs(5, base(HilMode::kHybrid, 0));
+  runs[0].comp_delay_s = 0;
+  runs[1].comp_delay_s = 0.005 + hold;
+  runs[2].comp_order = 1;  // the default delay: 5 ms + lag + hold
+  HilOptions& ideal = runs[4];
   ideal.actuator_delay_s = 0;
   ideal.force_noise_n = ideal.force_lsb_n = 0;
-  ideal.comp_delay_s = 2 * 0.7 / (2 * M_PI * 20) + 0.5e-3;
-  double last_tracking = 1e9, last_response = 1e9;
-  for (const HilOptions* o : {&unc, &comp, &ideal}) {
-    const HilReport r = run_hil(tmd, *o);
+  ideal.comp_delay_s = lag + hold;
+  std::vector<double> tracking, response;
+  for (const HilOptions& o : runs) {
+    const HilReport r = run_hil(tmd, o);
     ASSERT_TRUE(r.hybrid && r.outputs_finite);
     const HilHybridReport& hy = *r.hybrid;
     SCOPED_TRACE(to_json(r)["hybrid"].dump());
     ASSERT_TRUE(hy.tracking_rms_pct && hy.response_rms_pct.size() == 10u && hy.response_rms_pct[9]);
-    EXPECT_LT(*hy.tracking_rms_pct, last_tracking);
-    EXPECT_LT(*hy.response_rms_pct[9], last_response);
-    last_tracking = *hy.tracking_rms_pct, last_response = *hy.response_rms_pct[9];
-    if (o == &comp)
+    tracking.push_back(*hy.tracking_rms_pct), response.push_back(*hy.response_rms_pct[9]);
+    if (&o == &runs[3]) {
+      EXPECT_NEAR(hy.compensation_delay_s, 0.005 + lag + hold, 1e-12);
       for (const std::optional<double>& v : hy.response_rms_pct) EXPECT_LE(*v, 2.0);
+    }
   }
-  EXPECT_LT(last_response, 0.05);  // ideal: a twentieth of a percent
+  for (int i = 1; i < 4; ++i) {
+    EXPECT_LT(tracking[i], tracking[i - 1]) << i;
+    EXPECT_LT(response[i], response[i - 1]) << i;
+  }
+  EXPECT_GT(response[0], 1.0);  // uncompensated: percents
+  EXPECT_LT(response[3], 0.05);
+  EXPECT_LT(tracking[4], tracking[3]);
+  EXPECT_LT(response[4], 0.05);
 }
 
 // What the table cannot carry, each refused naming the scene and the key: an

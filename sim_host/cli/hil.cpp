@@ -283,7 +283,7 @@ void add_hil(CLI::App& vines) {
       ->type_name("N")
       ->check(number_in(0, 1e9))
       ->group(hybrid);
-  cmd->add_option("--comp-delay", opt.comp_delay_s, "delay compensated (s; default: delay + 2 zeta/w; 0: none)")
+  cmd->add_option("--comp-delay", opt.comp_delay_s, "delay compensated (s; default: delay + 2 zeta/w + h/2, the command held over a period h; 0: none)")
       ->type_name("S")
       ->check(number_in(0, 1))
       ->group(hybrid);
