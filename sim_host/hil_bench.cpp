@@ -1,12 +1,14 @@
 #include "sim_host/hil_bench.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/hil_offline.hpp"
 #include "vines/contact_laws.hpp"
+#include "vines/link/ats.hpp"
 
 namespace vines::host {
 namespace {
@@ -73,8 +75,11 @@ link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   for (int i = 0; i < scene.params.frame.stories; ++i) c.drift_limit_m[i] = opt.drift_limit_m;
   c.residual_limit_mps2 = opt.residual_limit_mps2;
   c.residual_window_s = opt.residual_window_s;
+  constexpr link::CompKind kinds[] = {link::CompKind::kNone, link::CompKind::kPolynomial, link::CompKind::kAdaptive};
+  c.comp_kind = kinds[static_cast<int>(opt.comp)];
   c.comp_delay_s = opt.comp_delay_s;
   c.comp_order = static_cast<std::uint8_t>(opt.comp_order);
+  c.comp_window_s = opt.comp_window_s;
   c.budget_ticks = opt.budget_ticks;
   if (const char* why = link::validate_node(c)) throw std::runtime_error(why);
   return c;
@@ -101,7 +106,15 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   if (hybrid) check_specimen(sc);
   if (hybrid && o.comp_delay_s < 0)
     o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz) + 0.5 * b.h;
-  if (o.comp_delay_s < 0) o.comp_delay_s = 0;
+  if (o.comp_delay_s < 0 || o.comp == HilComp::kNone) o.comp_delay_s = 0;
+  if (hybrid && o.comp == HilComp::kAdaptive && o.comp_delay_s > link::kAtsHigh[1]) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "--comp-delay %.4g s (given, or the actuator's delay and lag): --comp adaptive starts a1 there, "
+                  "which must be 0 to %g s",
+                  o.comp_delay_s, link::kAtsHigh[1]);
+    throw std::runtime_error(why);
+  }
   b.cfg = node_config(sc, o);
   b.image = model_image(b.cfg, sc.path);
   return b;

@@ -102,6 +102,7 @@ class HybridMode : public BenchMode {
     rec->table_x[k] = lab_->table_x();
   }
   double aux(long long k, const HilRecord& rec) const override { return rec.force[k]; }
+  double table_x(long long k, const HilRecord& rec) const override { return rec.table_x[k]; }
   void on_telemetry(const Telemetry& t) override { last_command_ = t.aux; }
 
   // Tracking: desired table motion (the frame's top floor) against the
@@ -123,13 +124,34 @@ class HybridMode : public BenchMode {
       hy.peak_top_pure_m = std::max(hy.peak_top_pure_m, std::fabs(offline[k].x[n - 1]));
     }
     hy.actuator_hz = o.actuator_hz, hy.actuator_zeta = o.actuator_zeta, hy.actuator_delay_s = o.actuator_delay_s;
+    hy.compensation = o.comp;
     hy.compensation_delay_s = o.comp_delay_s;
     hy.compensation_order = o.comp_order;
+    hy.compensation_window_s = o.comp_window_s;
+    if (o.comp == HilComp::kAdaptive) hy.adaptive = coefficients(rec);
     hy.force_noise_n = o.force_noise_n, hy.force_lsb_n = o.force_lsb_n;
     hy.tracking_rms_m = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
     hy.top_diff_from_pure_rms_m = used ? std::sqrt(dss / static_cast<double>(used)) : 0.0;
     criteria(rec, offline, &hy);
     r->hybrid = hy;
+  }
+
+  // The adaptive compensator's coefficients from the telemetry: the last
+  // received, and their range over the run.
+  static HilAtsCoefficients coefficients(const HilRecord& rec) {
+    HilAtsCoefficients c;
+    bool first = true;
+    for (long long k = 0; k < rec.samples; ++k) {
+      if (!rec.got[k]) continue;
+      for (int i = 0; i < 3; ++i) {
+        const double v = rec.tel[k].comp[i];
+        c.last[i] = v;
+        c.min[i] = first ? v : std::min(c.min[i], v);
+        c.max[i] = first ? v : std::max(c.max[i], v);
+      }
+      first = false;
+    }
+    return c;
   }
 
   // The vRTHS benchmark's criteria (rths_criteria.hpp) on the whole run: the

@@ -36,10 +36,21 @@ json to_json(const HilTwinReport& t) {
           {"stories_alarmed", t.stories_alarmed}};
 }
 
+json to_json(const std::optional<HilAtsCoefficients>& a) {
+  if (!a) return nullptr;
+  json j;
+  const char* names[3] = {"a0", "a1_s", "a2_s2"};
+  for (int i = 0; i < 3; ++i) j[names[i]] = {{"last", a->last[i]}, {"min", a->min[i]}, {"max", a->max[i]}};
+  return j;
+}
+
 json to_json(const HilHybridReport& h) {
   return {{"actuator", {{"hz", h.actuator_hz}, {"zeta", h.actuator_zeta}, {"delay_s", h.actuator_delay_s}}},
+          {"compensation", hil_comp_name(h.compensation)},
           {"compensation_delay_s", h.compensation_delay_s},
           {"compensation_order", h.compensation_order},
+          {"compensation_window_s", h.compensation_window_s},
+          {"adaptive", to_json(h.adaptive)},
           {"force_noise_n", h.force_noise_n},
           {"force_lsb_n", h.force_lsb_n},
           {"tracking_rms_m", h.tracking_rms_m},
