@@ -13,8 +13,8 @@
 // response): a linear relation holds between the filtered signals too, and
 // the polynomial, which cannot be the servo's inverse at every frequency, is
 // fitted where the response is rather than to the content of impacts, which
-// the servo does not follow (unfiltered, a VI NES's impacts pull a1 down by
-// 0.6 ms on El Centro).
+// the servo does not follow (unfiltered, a VI NES's impacts pull a1 0.5 ms
+// short on El Centro and the table stays 0.8 ms behind).
 // Fixed memory, no heap: the same code runs on the host and on a board.
 #pragma once
 
