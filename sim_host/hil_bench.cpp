@@ -1,12 +1,14 @@
 #include "sim_host/hil_bench.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "sim_host/hil_offline.hpp"
 #include "vines/contact_laws.hpp"
+#include "vines/link/ats.hpp"
 
 namespace vines::host {
 namespace {
@@ -22,6 +24,21 @@ std::string finite_laws() {
   for (std::size_t i = 0; i < names.size(); ++i)
     out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
   return out;
+}
+
+// The scene's device as the hybrid mode's specimen: a TMD or a VI NES of a
+// finite-duration law, on the top floor (the table plays it).
+void check_specimen(const Scene& sc) {
+  const DeviceParams& d = sc.params.device;
+  const int n = sc.params.frame.stories;
+  if (d.kind == DeviceKind::kNone)
+    throw std::runtime_error(sc.path + ": --mode hybrid needs a device on the table (device.kind tmd or vines)");
+  if (d.kind == DeviceKind::kVines && law_impulsive(d.vines.law))
+    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law (" +
+                             finite_laws() + "): the table's load cell measures contact forces");
+  if (d.floor != 0 && d.floor != n)
+    throw std::runtime_error(sc.path + ": --mode hybrid: device.floor " + std::to_string(d.floor) +
+                             ": the table plays the top floor (0 or " + std::to_string(n) + ")");
 }
 
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
@@ -56,8 +73,11 @@ link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   for (int i = 0; i < scene.params.frame.stories; ++i) c.drift_limit_m[i] = opt.drift_limit_m;
   c.residual_limit_mps2 = opt.residual_limit_mps2;
   c.residual_window_s = opt.residual_window_s;
+  constexpr link::CompKind kinds[] = {link::CompKind::kNone, link::CompKind::kPolynomial, link::CompKind::kAdaptive};
+  c.comp_kind = kinds[static_cast<int>(opt.comp)];
   c.comp_delay_s = opt.comp_delay_s;
   c.comp_order = static_cast<std::uint8_t>(opt.comp_order);
+  c.comp_window_s = opt.comp_window_s;
   c.budget_ticks = opt.budget_ticks;
   if (const char* why = link::validate_node(c)) throw std::runtime_error(why);
   return c;
@@ -75,15 +95,24 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   b.ex = load_excitation(sc, "");
   b.samples = static_cast<long long>(b.ex.samples.size());
   b.h = 1.0 / sc.params.loop.sensor_rate_hz;
-  // Hybrid: the table's load cell measures contact forces, and the command
-  // is compensated by default for the actuator's delay and lag (2 zeta / w).
+  // Hybrid: the table carries the device and plays the top floor; its load
+  // cell measures forces (a VI NES's contacts must last), and the command is
+  // compensated by default for the actuator's delay, its lag (2 zeta / w)
+  // and the command's hold over a period (h / 2).
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
-  if (hybrid && (sc.params.device.kind != DeviceKind::kVines || law_impulsive(sc.params.device.vines.law)))
-    throw std::runtime_error(sc.path + ": --mode hybrid needs a VI NES scene with a finite-duration contact law (" +
-                             finite_laws() + "): the table's load cell measures contact forces");
-  if (hybrid && o.comp_delay_s < 0) o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz);
-  if (o.comp_delay_s < 0) o.comp_delay_s = 0;
+  if (hybrid) check_specimen(sc);
+  if (hybrid && o.comp_delay_s < 0)
+    o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz) + 0.5 * b.h;
+  if (o.comp_delay_s < 0 || o.comp == HilComp::kNone) o.comp_delay_s = 0;
+  if (hybrid && o.comp == HilComp::kAdaptive && o.comp_delay_s > link::kAtsHigh[1]) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "--comp-delay %.4g s (given, or the actuator's delay and lag): --comp adaptive starts a1 there, "
+                  "which must be 0 to %g s",
+                  o.comp_delay_s, link::kAtsHigh[1]);
+    throw std::runtime_error(why);
+  }
   b.cfg = node_config(sc, o);
   b.image = model_image(b.cfg, sc.path);
   return b;

@@ -6,28 +6,30 @@
 
 namespace vines::host {
 
-ShakeTable::ShakeTable(const VinesDesign& d, ContactLaw law, double particle_x0, double particle_v0, double h,
-                       const LabOptions& opt)
-    : d_(d), law_(law), h_(h), opt_(opt), rng_(opt.seed) {
+ShakeTable::ShakeTable(const Specimen& sp, double h, const LabOptions& opt)
+    : sp_(sp), mass_(sp.kind == DeviceKind::kTmd ? sp.tmd.mass : sp.vines.mass), h_(h), opt_(opt), rng_(opt.seed) {
   sub_ = static_cast<int>(std::ceil(h / 20e-6));
   const double dt = h / sub_;
   pipeline_.assign(static_cast<std::size_t>(std::llround(opt.delay_s / dt)), 0.0);
-  s_ = particle_x0;
-  sd_ = particle_v0;
+  s_ = sp.x0;
+  sd_ = sp.v0;
 }
 
-double ShakeTable::contact_force(double s, double sd, double xt, double vt) const {
-  // The law's force; none for an instantaneous law (refused by the bench: a
-  // load cell sees no impulse).
-  auto kernel = [&](double d, double dd) {
+double ShakeTable::force_on_mass(double s, double sd, double xt, double vt) const {
+  // TMD: the spring and the dashpot between the mass and the table.
+  if (sp_.kind == DeviceKind::kTmd) return -sp_.tmd.k * (s - xt) - sp_.tmd.c * (sd - vt);
+  // VI NES: the law's force; none for an instantaneous law (refused by the
+  // bench: a load cell sees no impulse).
+  const VinesDesign& d = sp_.vines;
+  auto kernel = [&](double o, double od) {
     double f = 0.0;
-    with_law(law_, [&](auto law) {
+    with_law(sp_.law, [&](auto law) {
       using L = decltype(law);
-      if constexpr (!L::kImpulsive) f = L::template kernel<double>(d_)(d, dd).total();
+      if constexpr (!L::kImpulsive) f = L::template kernel<double>(d)(o, od).total();
     });
     return f;
   };
-  const double left = (xt - d_.gap) - s, right = s - (xt + d_.gap);
+  const double left = (xt - d.gap) - s, right = s - (xt + d.gap);
   if (left > 0) return kernel(left, vt - sd);
   if (right > 0) return -kernel(right, sd - vt);
   return 0.0;
@@ -46,7 +48,7 @@ double ShakeTable::advance(double command, double a0, double a1) {
       dy[0] = y[1];
       dy[1] = w * w * (u - y[0]) - 2 * z * w * y[1];
       dy[2] = y[3];
-      dy[3] = -ag + contact_force(y[2], y[3], y[0], y[1]) / d_.mass;
+      dy[3] = -ag + force_on_mass(y[2], y[3], y[0], y[1]) / mass_;
     };
     const double t = i * dt, y0[4] = {x_, v_, s_, sd_};
     double k1[4], k2[4], k3[4], k4[4], y[4];
@@ -62,8 +64,8 @@ double ShakeTable::advance(double command, double a0, double a1) {
     s_ = y0[2] + dt / 6 * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]);
     sd_ = y0[3] + dt / 6 * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]);
   }
-  contact_ = contact_force(s_, sd_, x_, v_);
-  const double measured = -contact_ + opt_.force_noise_n * noise_(rng_);
+  force_ = force_on_mass(s_, sd_, x_, v_);
+  const double measured = -force_ + opt_.force_noise_n * noise_(rng_);
   return opt_.force_lsb_n > 0 ? opt_.force_lsb_n * std::round(measured / opt_.force_lsb_n) : measured;
 }
 

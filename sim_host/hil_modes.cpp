@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/hil_lab.hpp"
 #include "sim_host/hil_offline.hpp"
+#include "sim_host/rths_criteria.hpp"
 
 namespace vines::host {
 namespace {
@@ -69,8 +71,8 @@ class TwinMode : public BenchMode {
 };
 
 // Hybrid: the node's bare frame commands the table (its top floor's motion);
-// the lab moves the table with the VI NES on it, and the load cell's force
-// goes back to the node.
+// the lab moves the table with the scene's device on it (VI NES or TMD), and
+// the load cell's force goes back to the node.
 class HybridMode : public BenchMode {
  public:
   HybridMode(const Bench& b, const Telemetry& initial) : b_(b) {
@@ -78,8 +80,18 @@ class HybridMode : public BenchMode {
     const std::unique_ptr<Engine> eng = build_engine(sc.params, sc.scalar, sc.path);
     const HilOptions& o = b.opt;
     const LabOptions lo{o.actuator_hz, o.actuator_zeta, o.actuator_delay_s, o.force_noise_n, o.force_lsb_n, o.seed};
-    lab_ = std::make_unique<ShakeTable>(eng->info().vines, sc.params.device.vines.law, initial.particle_x,
-                                        initial.particle_v, b.h, lo);
+    // The specimen where the pure simulation starts it: the VI NES particle
+    // as the offline run reads it, the TMD at its initial conditions
+    // (relative to the top floor, at rest at 0 like the table).
+    Specimen sp;
+    sp.kind = sc.params.device.kind;
+    sp.vines = eng->info().vines;
+    sp.law = sc.params.device.vines.law;
+    sp.tmd = eng->info().tmd;
+    const TmdParams& tp = sc.params.device.tmd;
+    sp.x0 = sp.kind == DeviceKind::kTmd ? tp.initial_position_m : initial.particle_x;
+    sp.v0 = sp.kind == DeviceKind::kTmd ? tp.initial_velocity_mps : initial.particle_v;
+    lab_ = std::make_unique<ShakeTable>(sp, b.h, lo);
   }
 
   // The table follows the last command received; the load cell reads the
@@ -90,6 +102,7 @@ class HybridMode : public BenchMode {
     rec->table_x[k] = lab_->table_x();
   }
   double aux(long long k, const HilRecord& rec) const override { return rec.force[k]; }
+  double table_x(long long k, const HilRecord& rec) const override { return rec.table_x[k]; }
   void on_telemetry(const Telemetry& t) override { last_command_ = t.aux; }
 
   // Tracking: desired table motion (the frame's top floor) against the
@@ -111,12 +124,61 @@ class HybridMode : public BenchMode {
       hy.peak_top_pure_m = std::max(hy.peak_top_pure_m, std::fabs(offline[k].x[n - 1]));
     }
     hy.actuator_hz = o.actuator_hz, hy.actuator_zeta = o.actuator_zeta, hy.actuator_delay_s = o.actuator_delay_s;
+    hy.compensation = o.comp;
     hy.compensation_delay_s = o.comp_delay_s;
     hy.compensation_order = o.comp_order;
+    hy.compensation_window_s = o.comp_window_s;
+    if (o.comp == HilComp::kAdaptive) hy.adaptive = coefficients(rec);
     hy.force_noise_n = o.force_noise_n, hy.force_lsb_n = o.force_lsb_n;
     hy.tracking_rms_m = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
     hy.top_diff_from_pure_rms_m = used ? std::sqrt(dss / static_cast<double>(used)) : 0.0;
+    criteria(rec, offline, &hy);
     r->hybrid = hy;
+  }
+
+  // The adaptive compensator's coefficients from the telemetry: the last
+  // received, and their range over the run.
+  static HilAtsCoefficients coefficients(const HilRecord& rec) {
+    HilAtsCoefficients c;
+    bool first = true;
+    for (long long k = 0; k < rec.samples; ++k) {
+      if (!rec.got[k]) continue;
+      for (int i = 0; i < 3; ++i) {
+        const double v = rec.tel[k].comp[i];
+        c.last[i] = v;
+        c.min[i] = first ? v : std::min(c.min[i], v);
+        c.max[i] = first ? v : std::max(c.max[i], v);
+      }
+      first = false;
+    }
+    return c;
+  }
+
+  // The vRTHS benchmark's criteria (rths_criteria.hpp) on the whole run: the
+  // table against the frame's top floor (the target before compensation),
+  // each floor against the pure simulation. A step without telemetry holds
+  // the node's last one.
+  void criteria(const HilRecord& rec, const std::vector<Telemetry>& offline, HilHybridReport* hy) const {
+    const int n = b_.scene.params.frame.stories;
+    const auto K = static_cast<std::size_t>(rec.samples);
+    std::vector<std::vector<double>> hybrid(static_cast<std::size_t>(n), std::vector<double>(K)),
+        pure(static_cast<std::size_t>(n), std::vector<double>(K));
+    const Telemetry* last = &offline[0];
+    for (std::size_t k = 0; k < K; ++k) {
+      if (rec.got[k]) last = &rec.tel[k];
+      for (int i = 0; i < n; ++i) hybrid[i][k] = last->x[i], pure[i][k] = offline[k].x[i];
+    }
+    const std::vector<double>& target = hybrid[static_cast<std::size_t>(n - 1)];
+    if (K >= 3) {
+      const std::optional<double> d = rths::tracking_delay_s(target, rec.table_x, b_.h, std::max(0.1, 2 * b_.h));
+      if (d) hy->tracking_delay_ms = 1e3 * *d;
+    }
+    hy->tracking_rms_pct = rths::rms_error_pct(target, rec.table_x);
+    hy->tracking_peak_pct = rths::peak_error_pct(target, rec.table_x);
+    for (int i = 0; i < n; ++i) {
+      hy->response_rms_pct.push_back(rths::rms_error_pct(pure[i], hybrid[i]));
+      hy->response_peak_pct.push_back(rths::peak_error_pct(pure[i], hybrid[i]));
+    }
   }
 
  private:

@@ -22,6 +22,8 @@ class BenchMode {
   virtual void drive(long long /*k*/, HilRecord* /*rec*/) {}
   // The aux channel of sample k's frame (twin: measured acceleration; hybrid: measured force).
   virtual double aux(long long /*k*/, const HilRecord& /*rec*/) const { return 0.0; }
+  // The measured table displacement in sample k's frame (hybrid only).
+  virtual double table_x(long long /*k*/, const HilRecord& /*rec*/) const { return 0.0; }
   // Telemetry of the run came back (hybrid: the table's next command).
   virtual void on_telemetry(const link::Telemetry& /*t*/) {}
   // The mode's part of the report.

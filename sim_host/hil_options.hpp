@@ -30,6 +30,12 @@ enum class HilMode { kReplay, kTwin, kHybrid };
 inline constexpr const char* kHilModeNames[] = {"replay", "twin", "hybrid"};
 inline const char* hil_mode_name(HilMode m) { return kHilModeNames[static_cast<int>(m)]; }
 
+// The hybrid node's compensation of the table's delay: none, polynomial
+// extrapolation, adaptive (ATS); names for --comp and the report.
+enum class HilComp { kNone, kPoly, kAdaptive };
+inline constexpr const char* kHilCompNames[] = {"none", "poly", "adaptive"};
+inline const char* hil_comp_name(HilComp c) { return kHilCompNames[static_cast<int>(c)]; }
+
 struct HilOptions {
   HilMode mode = HilMode::kReplay;
   bool realtime = false;
@@ -52,8 +58,10 @@ struct HilOptions {
   // hybrid
   double actuator_hz = 20, actuator_zeta = 0.7, actuator_delay_s = 0.005;
   double force_noise_n = 50, force_lsb_n = 10;
-  double comp_delay_s = -1;  // < 0: the actuator's delay plus its lag (2 zeta / w)
+  HilComp comp = HilComp::kPoly;
+  double comp_delay_s = -1;  // < 0: the actuator's delay, its lag (2 zeta / w) and the hold's h / 2
   int comp_order = 2;
+  double comp_window_s = 1;  // adaptive: memory of the fit
   // The node: "host" (this program's `vines node`), "qemu:cortex-m4f" or
   // "qemu:cortex-m7" (the board image in QEMU, instructions counted), or the
   // path of a program that speaks the link on stdin/stdout.

@@ -17,6 +17,12 @@ json to_json(const std::optional<HilStats>& s) {
 
 json to_json(const std::optional<double>& x) { return x ? json(*x) : json(nullptr); }
 
+json to_json(const std::vector<std::optional<double>>& xs) {
+  json a = json::array();
+  for (const auto& x : xs) a.push_back(to_json(x));
+  return a;
+}
+
 json to_json(const HilTwinReport& t) {
   return {{"truth_stiffness_scale", t.truth_stiffness_scale},
           {"residual_rms_mps2", t.residual_rms_mps2},
@@ -30,10 +36,21 @@ json to_json(const HilTwinReport& t) {
           {"stories_alarmed", t.stories_alarmed}};
 }
 
+json to_json(const std::optional<HilAtsCoefficients>& a) {
+  if (!a) return nullptr;
+  json j;
+  const char* names[3] = {"a0", "a1_s", "a2_s2"};
+  for (int i = 0; i < 3; ++i) j[names[i]] = {{"last", a->last[i]}, {"min", a->min[i]}, {"max", a->max[i]}};
+  return j;
+}
+
 json to_json(const HilHybridReport& h) {
   return {{"actuator", {{"hz", h.actuator_hz}, {"zeta", h.actuator_zeta}, {"delay_s", h.actuator_delay_s}}},
+          {"compensation", hil_comp_name(h.compensation)},
           {"compensation_delay_s", h.compensation_delay_s},
           {"compensation_order", h.compensation_order},
+          {"compensation_window_s", h.compensation_window_s},
+          {"adaptive", to_json(h.adaptive)},
           {"force_noise_n", h.force_noise_n},
           {"force_lsb_n", h.force_lsb_n},
           {"tracking_rms_m", h.tracking_rms_m},
@@ -41,7 +58,12 @@ json to_json(const HilHybridReport& h) {
           {"top_diff_from_pure_rms_m", h.top_diff_from_pure_rms_m},
           {"top_diff_from_pure_peak_m", h.top_diff_from_pure_peak_m},
           {"peak_top_hybrid_m", h.peak_top_hybrid_m},
-          {"peak_top_pure_m", h.peak_top_pure_m}};
+          {"peak_top_pure_m", h.peak_top_pure_m},
+          {"tracking_delay_ms", to_json(h.tracking_delay_ms)},
+          {"tracking_rms_pct", to_json(h.tracking_rms_pct)},
+          {"tracking_peak_pct", to_json(h.tracking_peak_pct)},
+          {"response_rms_pct", to_json(h.response_rms_pct)},
+          {"response_peak_pct", to_json(h.response_peak_pct)}};
 }
 
 }  // namespace

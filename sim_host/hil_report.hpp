@@ -64,16 +64,29 @@ struct HilTwinReport {
   std::vector<int> stories_alarmed;  // from 1
 };
 
+// The adaptive compensator's coefficients a0, a1 [s], a2 [s^2] (link/ats.hpp):
+// at the end of the run, and their least and largest over it.
+struct HilAtsCoefficients {
+  double last[3] = {}, min[3] = {}, max[3] = {};
+};
+
 // Hybrid mode: the actuator, its compensation, the tracking of the table and
-// the top floor against the pure simulation.
+// the top floor against the pure simulation, and the vRTHS benchmark's
+// criteria (rths_criteria.hpp; none where the reference is zero throughout
+// or the delay is beyond the search).
 struct HilHybridReport {
   double actuator_hz = 0, actuator_zeta = 0, actuator_delay_s = 0;
-  double compensation_delay_s = 0;
+  HilComp compensation = HilComp::kPoly;
+  double compensation_delay_s = 0;  // polynomial: the delay extrapolated over; adaptive: initial a1
   int compensation_order = 0;
+  double compensation_window_s = 0;
+  std::optional<HilAtsCoefficients> adaptive;  // adaptive only
   double force_noise_n = 0, force_lsb_n = 0;
   double tracking_rms_m = 0, tracking_peak_m = 0;
   double top_diff_from_pure_rms_m = 0, top_diff_from_pure_peak_m = 0;
   double peak_top_hybrid_m = 0, peak_top_pure_m = 0;
+  std::optional<double> tracking_delay_ms, tracking_rms_pct, tracking_peak_pct;
+  std::vector<std::optional<double>> response_rms_pct, response_peak_pct;  // per floor, bottom first
 };
 
 struct HilReport {

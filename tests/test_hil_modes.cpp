@@ -3,11 +3,15 @@
 // without delay compensation, and a configuration the node must refuse.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "sim_host/hil.hpp"
 #include "sim_host/hil_child.hpp"
+#include "vines/link/ats.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"
@@ -86,6 +90,15 @@ TEST(HilHybrid, CompensationReducesTrackingError) {
   EXPECT_GT(ha.compensation_delay_s, 0.005);
   EXPECT_LT(ha.tracking_rms_m, 0.2 * hb.tracking_rms_m);
   EXPECT_LT(ha.tracking_peak_m, hb.tracking_peak_m);
+  // The vRTHS criteria: uncompensated, the table lags by the servo's delay
+  // (5 ms), its lag 2 zeta / w (11.14 ms) and half a period of the command's
+  // hold (0.5 ms); compensated, by under a millisecond. Each floor is judged.
+  ASSERT_TRUE(ha.tracking_delay_ms && hb.tracking_delay_ms);
+  EXPECT_NEAR(*hb.tracking_delay_ms, 5 + 1e3 * 2 * 0.7 / (2 * M_PI * 20) + 0.5, 0.3);
+  EXPECT_LT(std::fabs(*ha.tracking_delay_ms), 1.0);
+  EXPECT_LT(*ha.tracking_rms_pct, 0.2 * *hb.tracking_rms_pct);
+  EXPECT_EQ(ha.response_rms_pct.size(), 10u);
+  EXPECT_EQ(ha.response_peak_pct.size(), 10u);
   for (const HilReport* r : {&a, &b}) {
     EXPECT_TRUE(r->outputs_finite);
     EXPECT_LT(r->hybrid->peak_top_hybrid_m, 2 * r->hybrid->peak_top_pure_m);
@@ -107,9 +120,135 @@ TEST(HilHybrid, IdealActuatorReproducesThePureSimulationPeak) {
   EXPECT_NEAR(hy.peak_top_hybrid_m, hy.peak_top_pure_m, 0.05 * hy.peak_top_pure_m) << to_json(r)["hybrid"].dump();
 }
 
-TEST(HilHybrid, RefusesAnInstantaneousLaw) {
-  Scene sc = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines_restitution.toml");
-  EXPECT_THROW(run_hil(sc, base(HilMode::kHybrid, 1.0)), std::runtime_error);
+// A linear specimen (the TMD): the hybrid response converges to the pure
+// simulation as the tracking error shrinks. On the default actuator (16.6 ms
+// behind): uncompensated, compensated for the pure delay and the hold only
+// (5.5 ms), then for the servo's lag too (16.6 ms) by order 1 and order 2:
+// the tracking and the top floor's RMS error fall at each, within the
+// issue's 2 % once compensated. The ideal (the same 20 Hz servo without
+// delay or load-cell noise, compensated for its lag 2 zeta / w and the hold
+// h / 2) and order 2 meet at the floor the held command leaves (about 0.01 %).
+// (A 2 kHz servo would follow the held command in steps, its velocity zero at
+// each sample: the load cell then misses the dashpot's force and the response
+// is 8 % off; a smooth servo is the ideal here.)
+TEST(HilHybrid, TmdSpecimenConvergesToThePureSimulation) {
+  const Scene tmd = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_tmd.toml");
+  const double lag = 2 * 0.7 / (2 * M_PI * 20), hold = 0.5e-3;
+  std::vector<HilOptions> runs(5, base(HilMode::kHybrid, 0));
+  runs[0].comp_delay_s = 0;
+  runs[1].comp_delay_s = 0.005 + hold;
+  runs[2].comp_order = 1;  // the default delay: 5 ms + lag + hold
+  HilOptions& ideal = runs[4];
+  ideal.actuator_delay_s = 0;
+  ideal.force_noise_n = ideal.force_lsb_n = 0;
+  ideal.comp_delay_s = lag + hold;
+  std::vector<double> tracking, response;
+  for (const HilOptions& o : runs) {
+    const HilReport r = run_hil(tmd, o);
+    ASSERT_TRUE(r.hybrid && r.outputs_finite);
+    const HilHybridReport& hy = *r.hybrid;
+    SCOPED_TRACE(to_json(r)["hybrid"].dump());
+    ASSERT_TRUE(hy.tracking_rms_pct && hy.response_rms_pct.size() == 10u && hy.response_rms_pct[9]);
+    tracking.push_back(*hy.tracking_rms_pct), response.push_back(*hy.response_rms_pct[9]);
+    if (&o == &runs[3]) {
+      EXPECT_NEAR(hy.compensation_delay_s, 0.005 + lag + hold, 1e-12);
+      for (const std::optional<double>& v : hy.response_rms_pct) EXPECT_LE(*v, 2.0);
+    }
+  }
+  for (int i = 1; i < 4; ++i) {
+    EXPECT_LT(tracking[i], tracking[i - 1]) << i;
+    EXPECT_LT(response[i], response[i - 1]) << i;
+  }
+  EXPECT_GT(response[0], 1.0);  // uncompensated: percents
+  EXPECT_LT(response[3], 0.05);
+  EXPECT_LT(tracking[4], tracking[3]);
+  EXPECT_LT(response[4], 0.05);
+}
+
+// The adaptive compensator (ATS) on El Centro and the default actuator meets
+// the targets, tracking delay within 0.5 ms and RMS within 2 %, with
+// the VI NES (whose impacts the fit must not follow) and the TMD, whose
+// response stays within 2 % on every floor. Its coefficients stay within
+// their bounds over the run, and a1 ends at the actuator's total lag:
+// delay 5 ms + 2 zeta / w 11.14 ms + the hold's 0.5 ms.
+TEST(HilHybrid, AdaptiveMeetsTheTargetsOnTheDefaultActuator) {
+  for (const char* scene : {"elcentro_vines", "elcentro_tmd"}) {
+    HilOptions o = base(HilMode::kHybrid, 0);
+    o.comp = HilComp::kAdaptive;
+    const HilReport r = run_hil(load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/" + scene + ".toml"), o);
+    ASSERT_TRUE(r.hybrid && r.outputs_finite);
+    const HilHybridReport& hy = *r.hybrid;
+    SCOPED_TRACE(std::string(scene) + ": " + to_json(r)["hybrid"].dump());
+    ASSERT_TRUE(hy.tracking_delay_ms && hy.tracking_rms_pct && hy.adaptive);
+    EXPECT_LE(std::fabs(*hy.tracking_delay_ms), 0.5);
+    EXPECT_LE(*hy.tracking_rms_pct, 2.0);
+    const HilAtsCoefficients& c = *hy.adaptive;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_GE(c.min[i], link::kAtsLow[i]) << i;
+      EXPECT_LE(c.max[i], link::kAtsHigh[i]) << i;
+    }
+    EXPECT_NEAR(c.last[1], 0.005 + 2 * 0.7 / (2 * M_PI * 20) + 0.5e-3, 0.3e-3);
+    if (std::string(scene) == "elcentro_tmd")
+      for (const std::optional<double>& v : hy.response_rms_pct) EXPECT_LE(*v, 2.0);
+  }
+}
+
+// A perturbed actuator (a 10 ms delay; a softer servo, 10 Hz) that the node
+// only knows by its nominal delay (16.64 ms, the default actuator's): the
+// polynomial extrapolates over the wrong delay; the adaptive one starts from
+// it and learns the true lag (10 + 11.14 + 0.5 ms; 5 + 22.28 + 0.5 ms), so it
+// tracks better by both criteria.
+TEST(HilHybrid, AdaptiveTracksAPerturbedActuatorBetterThanThePolynomial) {
+  const double nominal = 0.005 + 2 * 0.7 / (2 * M_PI * 20) + 0.5e-3;
+  struct Case {
+    double hz, delay_s;
+  };
+  for (const Case& k : {Case{20, 0.010}, Case{10, 0.005}}) {
+    HilOptions poly = base(HilMode::kHybrid, 0);
+    poly.actuator_hz = k.hz, poly.actuator_delay_s = k.delay_s;
+    poly.comp_delay_s = nominal;
+    HilOptions ats = poly;
+    ats.comp = HilComp::kAdaptive;
+    const HilReport p = run_hil(vines_scene(), poly), a = run_hil(vines_scene(), ats);
+    ASSERT_TRUE(p.hybrid && a.hybrid);
+    const HilHybridReport &hp = *p.hybrid, &ha = *a.hybrid;
+    SCOPED_TRACE(to_json(p)["hybrid"].dump() + "\n" + to_json(a)["hybrid"].dump());
+    ASSERT_TRUE(hp.tracking_delay_ms && ha.tracking_delay_ms && ha.adaptive);
+    EXPECT_LT(std::fabs(*ha.tracking_delay_ms), 0.5);
+    EXPECT_GT(std::fabs(*hp.tracking_delay_ms), 2.0);
+    EXPECT_LT(*ha.tracking_rms_pct, *hp.tracking_rms_pct);
+    EXPECT_LT(*ha.tracking_peak_pct, *hp.tracking_peak_pct);
+    EXPECT_NEAR(ha.adaptive->last[1], k.delay_s + 2 * 0.7 / (2 * M_PI * k.hz) + 0.5e-3, 0.3e-3);
+  }
+}
+
+// What the table cannot carry, each refused naming the scene and the key: an
+// instantaneous contact law (no force for a load cell), no device, a device
+// below the top floor (the table plays the top floor); and an adaptive start
+// the compensator's bounds refuse, naming the option.
+TEST(HilHybrid, RefusesWhatTheTableCannotCarry) {
+  const std::string dir = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+  auto refusal = [](const Scene& sc, HilOptions o = base(HilMode::kHybrid, 1.0)) {
+    try {
+      run_hil(sc, o);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(not refused)");
+  };
+  EXPECT_NE(refusal(load_scene(dir + "elcentro_vines_restitution.toml")).find("finite-duration contact law"),
+            std::string::npos);
+  EXPECT_NE(refusal(load_scene(dir + "elcentro_bare.toml")).find("device.kind"), std::string::npos);
+  Scene low = load_scene(dir + "elcentro_tmd.toml");
+  low.params.device.floor = 3;
+  const std::string why = refusal(low);
+  EXPECT_NE(why.find("elcentro_tmd.toml"), std::string::npos) << why;
+  EXPECT_NE(why.find("device.floor 3"), std::string::npos) << why;
+  // Nor can the adaptive compensator start beyond a1's bound (0.1 s).
+  HilOptions slow = base(HilMode::kHybrid, 1.0);
+  slow.comp = HilComp::kAdaptive;
+  slow.comp_delay_s = 0.2;
+  EXPECT_NE(refusal(load_scene(dir + "elcentro_tmd.toml"), slow).find("--comp-delay 0.2 s"), std::string::npos);
 }
 
 // A node given a frame with a NaN mass refuses it and names the field.

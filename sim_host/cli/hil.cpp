@@ -5,6 +5,8 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,13 @@
 
 namespace vines::cli {
 namespace {
+
+// printf into a string.
+std::string format(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
 
 struct HilArgs {
   std::string scene_path;
@@ -65,11 +74,35 @@ void print_hil(const host::HilReport& r) {
   }
   if (r.hybrid) {
     const host::HilHybridReport& hy = *r.hybrid;
-    std::printf("  hybrid: compensation %.2f ms (order %d): tracking RMS %.3g mm, peak %.3g mm; top floor vs pure "
-                "simulation RMS %.3g mm, peak %.3g mm (peaks %.4f / %.4f m)\n",
-                1e3 * hy.compensation_delay_s, hy.compensation_order, 1e3 * hy.tracking_rms_m,
-                1e3 * hy.tracking_peak_m, 1e3 * hy.top_diff_from_pure_rms_m, 1e3 * hy.top_diff_from_pure_peak_m,
-                hy.peak_top_hybrid_m, hy.peak_top_pure_m);
+    // The compensation, then the tracking and the top floor against the pure simulation.
+    if (hy.compensation == host::HilComp::kAdaptive)
+      std::printf("  hybrid: adaptive compensation (window %.3g s, a1 from %.2f ms)", hy.compensation_window_s,
+                  1e3 * hy.compensation_delay_s);
+    else if (hy.compensation == host::HilComp::kPoly && hy.compensation_delay_s > 0)
+      std::printf("  hybrid: compensation %.2f ms (order %d)", 1e3 * hy.compensation_delay_s, hy.compensation_order);
+    else
+      std::printf("  hybrid: no compensation");
+    std::printf(": tracking RMS %.3g mm, peak %.3g mm; top floor vs pure simulation RMS %.3g mm, peak %.3g mm "
+                "(peaks %.4f / %.4f m)\n",
+                1e3 * hy.tracking_rms_m, 1e3 * hy.tracking_peak_m, 1e3 * hy.top_diff_from_pure_rms_m,
+                1e3 * hy.top_diff_from_pure_peak_m, hy.peak_top_hybrid_m, hy.peak_top_pure_m);
+    if (hy.adaptive) {
+      const host::HilAtsCoefficients& c = *hy.adaptive;
+      std::printf("    adaptive coefficients at the end (range over the run): a0 %.4f (%.4f to %.4f), a1 %.3f ms "
+                  "(%.3f to %.3f), a2 %.3g s^2 (%.3g to %.3g)\n",
+                  c.last[0], c.min[0], c.max[0], 1e3 * c.last[1], 1e3 * c.min[1], 1e3 * c.max[1], c.last[2], c.min[2],
+                  c.max[2]);
+    }
+    // The vRTHS benchmark's criteria (docs/rths_criteria.md); "n/a": no scale or beyond the search.
+    auto pct = [](const std::optional<double>& v) { return v ? format("%.3g", *v) : std::string("n/a"); };
+    std::printf("  vRTHS criteria: tracking delay %s ms, RMS %s %%, peak %s %%\n",
+                hy.tracking_delay_ms ? format("%.3f", *hy.tracking_delay_ms).c_str() : "n/a",
+                pct(hy.tracking_rms_pct).c_str(), pct(hy.tracking_peak_pct).c_str());
+    for (const auto& [name, v] : {std::pair{"RMS", &hy.response_rms_pct}, std::pair{"peak", &hy.response_peak_pct}}) {
+      std::printf("    response %-4s %% by floor (bottom first):", name);
+      for (const std::optional<double>& x : *v) std::printf(" %s", pct(x).c_str());
+      std::printf("\n");
+    }
   }
 }
 
@@ -264,13 +297,30 @@ void add_hil(CLI::App& vines) {
       ->type_name("N")
       ->check(number_in(0, 1e9))
       ->group(hybrid);
-  cmd->add_option("--comp-delay", opt.comp_delay_s, "delay compensated (s; default: delay + 2 zeta/w; 0: none)")
+  const std::vector<std::string> comps(std::begin(host::kHilCompNames), std::end(host::kHilCompNames));
+  cmd->add_option_function<std::string>(
+         "--comp",
+         [&opt, comps](const std::string& v) {
+           opt.comp = static_cast<host::HilComp>(std::find(comps.begin(), comps.end(), v) - comps.begin());
+         },
+         "the node's compensation of the table's delay: poly (default: polynomial extrapolation over --comp-delay), "
+         "adaptive (adaptive time series, ATS: u = a0 x + a1 x' + a2 x'', fitted online to the measured table; a1 "
+         "starts at --comp-delay), none")
+      ->type_name("poly|adaptive|none")
+      ->check(CLI::IsMember(comps))
+      ->group(hybrid);
+  cmd->add_option("--comp-delay", opt.comp_delay_s, "delay compensated (s; default: delay + 2 zeta/w + h/2, the command held over a period h; 0: none)")
       ->type_name("S")
       ->check(number_in(0, 1))
       ->group(hybrid);
   cmd->add_option("--comp-order", opt.comp_order, "order of the compensation (1-3, default 2)")
       ->type_name("P")
       ->check(number_in(1, 3))
+      ->group(hybrid);
+  cmd->add_option("--comp-window", opt.comp_window_s,
+                  "adaptive: memory of the fit, the time constant of its exponential forgetting (s, default 1)")
+      ->type_name("S")
+      ->check(number_in(0.05, 100))
       ->group(hybrid);
 }
 

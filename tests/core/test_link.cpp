@@ -175,12 +175,15 @@ M round_trip(const M& m) {
 }
 
 TEST(Messages, RoundTripBitForBit) {
-  Sample s{7, 123456789012ull, -0.1234567890123, std::numeric_limits<double>::quiet_NaN()};
+  Sample s{7, 123456789012ull, -0.1234567890123, std::numeric_limits<double>::quiet_NaN(), -0.0123456789};
   const Sample s2 = round_trip(s);
   EXPECT_EQ(s2.k, 7u);
   EXPECT_EQ(s2.t_ns, 123456789012ull);
   EXPECT_EQ(std::memcmp(&s2.ag, &s.ag, 8), 0);
   EXPECT_TRUE(std::isnan(s2.aux));
+  EXPECT_EQ(s2.table_x, s.table_x);
+  std::uint8_t sample_payload[kMaxPayload];
+  EXPECT_EQ(encode(s, sample_payload, sizeof sample_payload), 4u + 8 + 8 + 8 + 8);  // k, t_ns, ag, aux, table_x
 
   Telemetry t;
   t.rx = 9;
@@ -191,7 +194,9 @@ TEST(Messages, RoundTripBitForBit) {
   t.acc_top = -1e-300;
   t.dissipated = 5.5;
   t.drift_alarms = 1ull << 39;
+  t.comp[0] = 1.01, t.comp[1] = 0.0166, t.comp[2] = 1.4e-4;
   const Telemetry t2 = round_trip(t);
+  EXPECT_EQ(std::memcmp(t2.comp, t.comp, sizeof t.comp), 0);
   EXPECT_EQ(std::memcmp(t2.x, t.x, sizeof t.x), 0);
   EXPECT_EQ(t2.acc_top, t.acc_top);
   EXPECT_EQ(t2.flags, t.flags);
@@ -232,6 +237,8 @@ TEST(Config, RoundTripsEveryField) {
   c.scalar = 1;
   c.drift_limit_m[2] = 0.02;
   c.comp_order = 3;
+  c.comp_kind = CompKind::kAdaptive;
+  c.comp_window_s = 0.7;
   std::uint8_t blob[kMaxConfigBlob];
   const std::size_t n = encode(c, blob, sizeof blob);
   ASSERT_GT(n, 0u);
@@ -244,6 +251,8 @@ TEST(Config, RoundTripsEveryField) {
   EXPECT_EQ(d.scene.device.vines.law, ContactLaw::kTsuji);
   EXPECT_EQ(d.mode, NodeMode::kTwin);
   EXPECT_EQ(d.drift_limit_m[2], 0.02);
+  EXPECT_EQ(d.comp_kind, CompKind::kAdaptive);
+  EXPECT_EQ(d.comp_window_s, 0.7);
   EXPECT_EQ(validate_node(d), nullptr);
   EXPECT_FALSE(decode(blob, n - 1, &d));
   blob[0] = 41;  // stories out of range
@@ -253,6 +262,29 @@ TEST(Config, RoundTripsEveryField) {
   EXPECT_GT(encode(c, blob, sizeof blob), 0u);
   c.comp_order = 0;
   EXPECT_NE(validate_node(c), nullptr);
+}
+
+// The compensation settings out of range are refused naming the field: a
+// kind beyond adaptive (any u8 decodes, so that the node can say which), a
+// window outside 0.05-100 s, an adaptive start beyond a1's bound.
+TEST(Config, CompensationSettingsAreChecked) {
+  NodeConfig c;
+  c.scene.loop.sensor_rate_hz = 1000;
+  EXPECT_EQ(validate_node(c), nullptr);
+  std::uint8_t blob[kMaxConfigBlob];
+  c.comp_kind = static_cast<CompKind>(3);
+  const std::size_t n = encode(c, blob, sizeof blob);
+  NodeConfig d;
+  ASSERT_TRUE(decode(blob, n, &d));
+  EXPECT_STREQ(validate_node(d), "comp_kind: must be 0 (none), 1 (polynomial) or 2 (adaptive)");
+  c.comp_kind = CompKind::kAdaptive;
+  c.comp_window_s = 0.01;
+  EXPECT_STREQ(validate_node(c), "comp_window: must be 0.05 to 100 s");
+  c.comp_window_s = 1;
+  c.comp_delay_s = 0.2;  // fine for a polynomial...
+  EXPECT_STREQ(validate_node(c), "comp_delay: the adaptive compensator's initial a1 must be 0 to 0.1 s");
+  c.comp_kind = CompKind::kPolynomial;
+  EXPECT_EQ(validate_node(c), nullptr);  // ...not for the adaptive one
 }
 
 TEST(Extrapolate, ExactForPolynomialsOfItsOrder) {

@@ -21,6 +21,12 @@ enum class NodeMode : std::uint8_t {
   kHybrid,  // shake table: the bare frame with the measured device force in; table command out
 };
 
+// How a hybrid node compensates the table's delay: not at all (the command
+// is the target), by polynomial extrapolation over comp_delay_s
+// (extrapolate.hpp), or adaptively (ats.hpp, from a1 = comp_delay_s).
+enum class CompKind : std::uint8_t { kNone, kPolynomial, kAdaptive };
+inline constexpr std::uint8_t kCompKinds = 3;
+
 struct NodeConfig {
   SceneParams scene;
   std::uint8_t scalar = 0;  // 0 double, 1 float
@@ -34,8 +40,10 @@ struct NodeConfig {
   double residual_limit_mps2 = 0;          // RMS residual alarm threshold (0: none)
   double residual_window_s = 1.0;          // time constant of the running RMS
   // Hybrid:
-  double comp_delay_s = 0;   // actuator delay compensated by extrapolating the command
+  CompKind comp_kind = CompKind::kPolynomial;  // any u8 decodes; validate_node checks it
+  double comp_delay_s = 0;   // actuator delay compensated by extrapolating the command (adaptive: initial a1)
   std::uint8_t comp_order = 2;  // polynomial order of that extrapolation (1-3)
+  double comp_window_s = 1;  // adaptive: memory of the fit (time constant of its forgetting)
   // Deadline monitor: a step whose model work takes more than this many of
   // the node's counter ticks is an overrun (0: one sensor period).
   std::uint32_t budget_ticks = 0;
@@ -82,6 +90,8 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
   w.u8(static_cast<std::uint8_t>(l.contact_scheme));
   w.u8(static_cast<std::uint8_t>(l.bounded_substeps));
   w.u32(c.budget_ticks);
+  w.u8(static_cast<std::uint8_t>(c.comp_kind));
+  w.f64(c.comp_window_s);
   return w.ok() ? w.size() : 0;
 }
 
@@ -144,6 +154,8 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
   l.contact_scheme = static_cast<ContactScheme>(scheme);
   l.bounded_substeps = substeps;
   c->budget_ticks = r.u32();
+  c->comp_kind = static_cast<CompKind>(r.u8());
+  c->comp_window_s = r.f64();
   return r.done();
 }
 
@@ -162,6 +174,11 @@ inline const char* validate_node(const NodeConfig& c) {
   if (!(c.residual_window_s > 0.0 && std::isfinite(c.residual_window_s))) return "residual_window: must be > 0";
   if (!(c.comp_delay_s >= 0.0 && c.comp_delay_s <= 1.0)) return "comp_delay: must be 0 to 1 s";
   if (c.comp_order < 1 || c.comp_order > 3) return "comp_order: must be 1, 2 or 3";
+  if (static_cast<std::uint8_t>(c.comp_kind) >= kCompKinds)
+    return "comp_kind: must be 0 (none), 1 (polynomial) or 2 (adaptive)";
+  if (!(c.comp_window_s >= 0.05 && c.comp_window_s <= 100.0)) return "comp_window: must be 0.05 to 100 s";
+  if (c.comp_kind == CompKind::kAdaptive && c.comp_delay_s > 0.1)
+    return "comp_delay: the adaptive compensator's initial a1 must be 0 to 0.1 s";
   return nullptr;
 }
 

@@ -40,6 +40,7 @@ struct Sample {
   std::uint64_t t_ns = 0;  // bench clock when sent
   double ag = 0;           // ground acceleration [m/s^2]
   double aux = 0;          // twin: measured top-floor acceleration (NaN: none); hybrid: measured force [N]
+  double table_x = 0;      // hybrid: measured table displacement [m] (NaN: none); other modes: 0, unused
 };
 
 // node -> bench ------------------------------------------------------------
@@ -71,6 +72,7 @@ struct Telemetry {
   double aux = 0;        // twin: measured - predicted top acceleration; hybrid: command sent [m]
   std::uint64_t drift_alarms = 0;  // bit i: story i+1 beyond its limit
   std::uint32_t step_ticks = 0;    // the model's work for this step, in the node's counter ticks
+  double comp[3] = {};             // hybrid, adaptive: the compensator's a0, a1 [s], a2 [s^2]; else 0
 };
 
 // The node's deadline monitor: every step's model work timed on the node's
@@ -153,6 +155,7 @@ void layout(IO& io, M& s, Sample*) {
   io.field(s.t_ns);
   io.field(s.ag);
   io.field(s.aux);
+  io.field(s.table_x);
 }
 
 template <class IO, class M>
@@ -173,6 +176,7 @@ void layout(IO& io, M& t, Telemetry*) {
   io.field(t.aux);
   io.field(t.drift_alarms);
   io.field(t.step_ticks);
+  for (auto& c : t.comp) io.field(c);
 }
 
 template <class IO, class M>

@@ -27,7 +27,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
+#include "vines/link/ats.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/extrapolate.hpp"
 #include "vines/link/frame.hpp"
@@ -108,7 +110,7 @@ class Node {
     }
     while (deadline(status_.next_k) < now_) {
       fault(FaultCode::kHeld, status_.next_k, 1);
-      apply(a_last_, aux_last_, kHeld, false);
+      apply(a_last_, aux_last_, kNan, kHeld, false);
     }
     return true;
   }
@@ -243,6 +245,7 @@ class Node {
     filled_ = 0;
     ms_residual_ = 0;
     hist_n_ = 0;
+    ats_.reset(h_, cfg_.comp_window_s, cfg_.comp_delay_s);
     send_status();
   }
 
@@ -273,18 +276,22 @@ class Node {
     }
     if (!initialised_) {
       status_.next_k = s.k;
-      return apply(a, aux, flags, true);
+      return apply(a, aux, s.table_x, flags, true);
     }
-    // Samples missing before this one: interpolated towards it.
+    // Samples missing before this one: interpolated towards it (the table
+    // not measured there).
     const std::uint32_t gap = s.k - e;
     const double a0 = a_last_;
     for (std::uint32_t i = 1; i <= gap; ++i)
-      apply(a0 + (a - a0) * i / (gap + 1.0), aux_last_, kInterpolated | kAuxMissing, false);
-    apply(a, aux, flags, true);
+      apply(a0 + (a - a0) * i / (gap + 1.0), aux_last_, kNan, kInterpolated | kAuxMissing, false);
+    apply(a, aux, s.table_x, flags, true);
   }
 
   // ---- stepping ---------------------------------------------------------
-  void apply(double a, double aux, std::uint16_t flags, bool real) {
+  // One step on ground acceleration a, the measured value aux (twin:
+  // acceleration, hybrid: force) and, hybrid, the measured table
+  // displacement xm (NaN: not measured).
+  void apply(double a, double aux, double xm, std::uint16_t flags, bool real) {
     const std::uint32_t k = status_.next_k;
     const double f = cfg_.mode == NodeMode::kHybrid ? aux : 0.0;
     if (!initialised_) {
@@ -309,7 +316,7 @@ class Node {
     t.ag = a;
     t.flags = static_cast<std::uint16_t>(t.flags | flags);
     if (cfg_.mode == NodeMode::kTwin) twin(&t, aux, (flags & kAuxMissing) == 0);
-    if (cfg_.mode == NodeMode::kHybrid) t.aux = command(t.x[t.n - 1]);
+    if (cfg_.mode == NodeMode::kHybrid) t.aux = command(t.x[t.n - 1], xm, &t);
     send(MsgType::kTelemetry, t);
   }
 
@@ -328,8 +335,16 @@ class Node {
     }
   }
 
-  // Hybrid: the table command, the top floor extrapolated over the delay.
-  double command(double x_top) {
+  // Hybrid: the table command from the top floor: itself (none), extrapolated
+  // over the delay (polynomial), or the adaptive compensator's, fed the
+  // measured table too (its coefficients into the telemetry).
+  double command(double x_top, double xm, Telemetry* t) {
+    if (cfg_.comp_kind == CompKind::kNone) return x_top;
+    if (cfg_.comp_kind == CompKind::kAdaptive) {
+      const double u = ats_.step(x_top, xm);
+      for (int i = 0; i < 3; ++i) t->comp[i] = ats_.coefficient(i);
+      return u;
+    }
     for (int i = 3; i > 0; --i) hist_[i] = hist_[i - 1];
     hist_[0] = x_top;
     if (hist_n_ < 4) ++hist_n_;
@@ -417,6 +432,8 @@ class Node {
   double ms_residual_ = 0;
   double hist_[4] = {};
   int hist_n_ = 0;
+  Ats ats_;
+  static constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace vines::link
