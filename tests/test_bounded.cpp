@@ -298,8 +298,10 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   ASSERT_TRUE(link::decode(blob, n, &d));
   EXPECT_EQ(d.scene.loop.contact_scheme, ContactScheme::kBounded);
   EXPECT_EQ(d.scene.loop.bounded_substeps, 11);
-  // The scheme and budget bytes, before the deadline budget (u32, last).
-  const std::size_t at_scheme = n - 6, at_budget = n - 5;
+  // The scheme and budget bytes, before the deadline budget (u32) and the
+  // hybrid compensator's kind (u8) and window (f64), the last fields.
+  constexpr std::size_t kTail = 4 + 1 + 8;
+  const std::size_t at_scheme = n - kTail - 2, at_budget = n - kTail - 1;
   EXPECT_EQ(blob[at_scheme], 1);
   EXPECT_EQ(blob[at_budget], 11);
   for (const auto& [at, value] :
@@ -312,7 +314,7 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   // A blob of the previous layout (without the two bytes) is refused.
   std::uint8_t old[link::kMaxConfigBlob];
   std::memcpy(old, blob, at_scheme);
-  std::memcpy(old + at_scheme, blob + at_scheme + 2, 4);
+  std::memcpy(old + at_scheme, blob + at_scheme + 2, kTail);
   EXPECT_FALSE(link::decode(old, n - 2, &d));
 }
 
