@@ -92,6 +92,14 @@ class HybridMode : public BenchMode {
     sp.x0 = sp.kind == DeviceKind::kTmd ? tp.initial_position_m : initial.particle_x;
     sp.v0 = sp.kind == DeviceKind::kTmd ? tp.initial_velocity_mps : initial.particle_v;
     lab_ = std::make_unique<ShakeTable>(sp, b.h, lo);
+    // The bare frame on the same samples: the reference of x_r and E_r.
+    link::NodeConfig bare = b.cfg;
+    bare.mode = link::NodeMode::kReplay;
+    bare.scene.device.kind = DeviceKind::kNone;
+    const std::vector<Telemetry> t = offline_run(bare, b.ex.samples, sc.path);
+    const int top = sc.params.frame.stories - 1;
+    for (const Telemetry& s : t) bare_peak_ = std::max(bare_peak_, std::fabs(s.x[top]));
+    bare_ee_ = t.back().elastic_energy;
   }
 
   // The table follows the last command received; the load cell reads the
@@ -133,6 +141,14 @@ class HybridMode : public BenchMode {
     hy.tracking_rms_m = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
     hy.top_diff_from_pure_rms_m = used ? std::sqrt(dss / static_cast<double>(used)) : 0.0;
     criteria(rec, offline, &hy);
+    // x_r, E_r: the hybrid frame's last telemetry, the pure simulation's end.
+    const Telemetry* last = &offline[0];
+    for (long long k = 0; k < rec.samples; ++k)
+      if (rec.got[k]) last = &rec.tel[k];
+    hy.x_r_hybrid = 1 - hy.peak_top_hybrid_m / bare_peak_;
+    hy.x_r_pure = 1 - hy.peak_top_pure_m / bare_peak_;
+    hy.E_r_hybrid = 1 - last->elastic_energy / bare_ee_;
+    hy.E_r_pure = 1 - offline.back().elastic_energy / bare_ee_;
     r->hybrid = hy;
   }
 
@@ -185,6 +201,7 @@ class HybridMode : public BenchMode {
   const Bench& b_;
   std::unique_ptr<ShakeTable> lab_;
   double last_command_ = 0;
+  double bare_peak_ = 0, bare_ee_ = 0;  // the bare frame's peak top-floor displacement and E_e
 };
 
 }  // namespace

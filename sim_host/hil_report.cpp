@@ -63,7 +63,11 @@ json to_json(const HilHybridReport& h) {
           {"tracking_rms_pct", to_json(h.tracking_rms_pct)},
           {"tracking_peak_pct", to_json(h.tracking_peak_pct)},
           {"response_rms_pct", to_json(h.response_rms_pct)},
-          {"response_peak_pct", to_json(h.response_peak_pct)}};
+          {"response_peak_pct", to_json(h.response_peak_pct)},
+          {"x_r_hybrid", h.x_r_hybrid},
+          {"x_r_pure", h.x_r_pure},
+          {"E_r_hybrid", h.E_r_hybrid},
+          {"E_r_pure", h.E_r_pure}};
 }
 
 }  // namespace

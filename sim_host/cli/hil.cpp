@@ -86,6 +86,8 @@ void print_hil(const host::HilReport& r) {
                 "(peaks %.4f / %.4f m)\n",
                 1e3 * hy.tracking_rms_m, 1e3 * hy.tracking_peak_m, 1e3 * hy.top_diff_from_pure_rms_m,
                 1e3 * hy.top_diff_from_pure_peak_m, hy.peak_top_hybrid_m, hy.peak_top_pure_m);
+    std::printf("    against the bare frame: x_r %.2f %% (pure %.2f %%), E_r %.2f %% (pure %.2f %%)\n",
+                100 * hy.x_r_hybrid, 100 * hy.x_r_pure, 100 * hy.E_r_hybrid, 100 * hy.E_r_pure);
     if (hy.adaptive) {
       const host::HilAtsCoefficients& c = *hy.adaptive;
       std::printf("    adaptive coefficients at the end (range over the run): a0 %.4f (%.4f to %.4f), a1 %.3f ms "
