@@ -60,6 +60,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim_host/names.hpp"
 #include "sim_host/scene_limits.hpp"
 #include "sim_host/scene_section.hpp"
 #include "sim_host/scene_toml.hpp"
@@ -169,15 +170,8 @@ void read_record(const Section& s, Scene* scene) {
   hal::RecordSpec& r = scene->record;
   if (!s.read("path", &r.path) || r.path.empty())
     s.fail_at("path", "required: the ground-motion record file");
-  s.choose<hal::RecordFormat>("format",
-                              {{"auto", hal::RecordFormat::kAuto},
-                               {"at2", hal::RecordFormat::kAt2},
-                               {"time-accel", hal::RecordFormat::kTimeAccel},
-                               {"accel", hal::RecordFormat::kAccel}},
-                              &r.format);
-  s.choose<hal::Units>(
-      "units", {{"g", hal::Units::kG}, {"m/s2", hal::Units::kMps2}, {"cm/s2", hal::Units::kCmps2}},
-      &r.units);
+  s.choose<hal::RecordFormat>("format", kRecordFormats, &r.format);
+  s.choose<hal::Units>("units", kRecordUnits, &r.units);
   const bool accel = r.format == hal::RecordFormat::kAccel;
   if (s.read("dt_s", &r.dt_s)) {
     if (!accel) s.fail_at("dt_s", "only with format = \"accel\" (other formats carry their own)");

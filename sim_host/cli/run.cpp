@@ -1,6 +1,6 @@
 // `vines run SCENE.toml`: one scene (and its bare frame), summary.json and timeseries.csv.
+#include <algorithm>
 #include <cstdio>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,18 +14,13 @@
 namespace vines::cli {
 namespace {
 
-// --record-format and --record-units: the scene's [record] names.
-const std::map<std::string, hal::RecordFormat> kFormats = {{"auto", hal::RecordFormat::kAuto},
-                                                           {"at2", hal::RecordFormat::kAt2},
-                                                           {"time-accel", hal::RecordFormat::kTimeAccel},
-                                                           {"accel", hal::RecordFormat::kAccel}};
-const std::map<std::string, hal::Units> kUnits = {
-    {"g", hal::Units::kG}, {"m/s2", hal::Units::kMps2}, {"cm/s2", hal::Units::kCmps2}};
-
+// --record-format and --record-units take the scene's [record] names
+// (host::kRecordFormats, host::kRecordUnits), listed in sorted order.
 template <class E>
-std::vector<std::string> names_of(const std::map<std::string, E>& m) {
+std::vector<std::string> names_of(const host::NamedValues<E>& values) {
   std::vector<std::string> out;
-  for (const auto& kv : m) out.push_back(kv.first);
+  for (const auto& kv : values) out.emplace_back(kv.first);
+  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -40,8 +35,8 @@ struct RunArgs {
 int run(RunArgs a) {
   using namespace vines::host;
   RunOptions& opt = a.opt;
-  opt.record_reading.format = kFormats.at(a.record_format);
-  opt.record_reading.units = kUnits.at(a.record_units);
+  opt.record_reading.format = *host::named(host::kRecordFormats, a.record_format);  // checked by CLI11
+  opt.record_reading.units = *host::named(host::kRecordUnits, a.record_units);
   const Scene scene = load_scene(a.scene_path);
   if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(scene.name);
   const RunReport r = run_scene(scene, opt);
@@ -94,10 +89,10 @@ void add_run(CLI::App& vines) {
   auto* rec = cmd->get_option("--record");
   cmd->add_option("--record-format", a->record_format, "force the --record file's format: auto (default), at2, "
                                                        "time-accel or accel (values only, needs --record-dt)")
-      ->type_name("FORMAT")->check(CLI::IsMember(names_of(kFormats)))->needs(rec);
+      ->type_name("FORMAT")->check(CLI::IsMember(names_of(host::kRecordFormats)))->needs(rec);
   cmd->add_option("--record-units", a->record_units, "units of a --record columns file: g (default), m/s2 or "
                                                      "cm/s2 (an AT2 file's header says its own)")
-      ->type_name("UNITS")->check(CLI::IsMember(names_of(kUnits)))->needs(rec);
+      ->type_name("UNITS")->check(CLI::IsMember(names_of(host::kRecordUnits)))->needs(rec);
   host::RecordReading& how = a->opt.record_reading;
   cmd->add_option("--record-column", how.column, "acceleration column of a --record time/accel file "
                                                  "(1, the default, = the first after the time)")
