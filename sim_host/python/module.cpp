@@ -20,6 +20,7 @@
 
 #include "host/record.hpp"
 #include "sim_host/build_engine.hpp"
+#include "sim_host/names.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
 #include "sim_host/scene_toml.hpp"
@@ -107,18 +108,14 @@ PyScene with_overrides(const PyScene& s, const py::dict& overrides) {
   return make_scene(std::move(t), s.origin);
 }
 
+// units= and format= of Record: the scene's [record] names.
 hal::Units units_of(const std::string& u) {
-  if (u == "g") return hal::Units::kG;
-  if (u == "m/s2") return hal::Units::kMps2;
-  if (u == "cm/s2") return hal::Units::kCmps2;
+  if (const auto v = named(kRecordUnits, u)) return *v;
   throw std::invalid_argument("units: '" + u + "' (g, m/s2 or cm/s2)");
 }
 
 hal::RecordFormat format_of(const std::string& f) {
-  if (f == "auto") return hal::RecordFormat::kAuto;
-  if (f == "at2") return hal::RecordFormat::kAt2;
-  if (f == "time-accel") return hal::RecordFormat::kTimeAccel;
-  if (f == "accel") return hal::RecordFormat::kAccel;
+  if (const auto v = named(kRecordFormats, f)) return *v;
   throw std::invalid_argument("format: '" + f + "' (auto, at2, time-accel or accel)");
 }
 
@@ -163,41 +160,42 @@ PyRecord record_from_array(const py::array_t<double, py::array::c_style | py::ar
   return r;
 }
 
-// One column of snapshots as a numpy array.
-template <typename F>
-py::array_t<double> column(const std::vector<Snapshot>& rows, F get) {
-  py::array_t<double> out(static_cast<py::ssize_t>(rows.size()));
-  auto o = out.mutable_unchecked<1>();
-  for (std::size_t i = 0; i < rows.size(); ++i) o(static_cast<py::ssize_t>(i)) = get(rows[i]);
-  return out;
-}
+// A Snapshot's fields as Python names them (Series and Step, units in
+// vines/__init__.py): one value each, then one per floor.
+using ScalarOf = double (*)(const Snapshot&);
+constexpr std::pair<const char*, ScalarOf> kScalarFields[] = {
+    {"t", [](const Snapshot& s) { return s.t; }},
+    {"ag", [](const Snapshot& s) { return s.ag; }},
+    {"elastic_energy", [](const Snapshot& s) { return s.elastic_energy; }},
+    {"particle_x", [](const Snapshot& s) { return s.particle_x; }},
+    {"particle_v", [](const Snapshot& s) { return s.particle_v; }},
+    {"wall_left", [](const Snapshot& s) { return s.wall_left; }},
+    {"wall_right", [](const Snapshot& s) { return s.wall_right; }},
+    {"contact_force", [](const Snapshot& s) { return s.contact_force; }},
+    {"mode", [](const Snapshot& s) { return static_cast<double>(s.mode); }},
+    {"tmd_x", [](const Snapshot& s) { return s.tmd_x; }},
+    {"tmd_v", [](const Snapshot& s) { return s.tmd_v; }},
+};
+constexpr std::pair<const char*, FloorArray Snapshot::*> kFloorFields[] = {
+    {"x", &Snapshot::x}, {"v", &Snapshot::v}, {"acc", &Snapshot::acc}, {"drift", &Snapshot::drift}};
 
-// Per-floor columns (rows x stories).
-py::array_t<double> floors(const std::vector<Snapshot>& rows, int stories, const FloorArray Snapshot::*field) {
-  py::array_t<double> out({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(stories)});
-  auto o = out.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    for (int j = 0; j < stories; ++j) o(static_cast<py::ssize_t>(i), j) = (rows[i].*field)[static_cast<std::size_t>(j)];
-  return out;
-}
-
+// The series: one numpy array a field, over the rows (per floor: rows x stories).
 py::dict series_dict(const std::vector<Snapshot>& rows, int stories) {
+  const auto n = static_cast<py::ssize_t>(rows.size());
   py::dict d;
-  d["t"] = column(rows, [](const Snapshot& s) { return s.t; });
-  d["ag"] = column(rows, [](const Snapshot& s) { return s.ag; });
-  d["x"] = floors(rows, stories, &Snapshot::x);
-  d["v"] = floors(rows, stories, &Snapshot::v);
-  d["acc"] = floors(rows, stories, &Snapshot::acc);
-  d["drift"] = floors(rows, stories, &Snapshot::drift);
-  d["elastic_energy"] = column(rows, [](const Snapshot& s) { return s.elastic_energy; });
-  d["particle_x"] = column(rows, [](const Snapshot& s) { return s.particle_x; });
-  d["particle_v"] = column(rows, [](const Snapshot& s) { return s.particle_v; });
-  d["wall_left"] = column(rows, [](const Snapshot& s) { return s.wall_left; });
-  d["wall_right"] = column(rows, [](const Snapshot& s) { return s.wall_right; });
-  d["contact_force"] = column(rows, [](const Snapshot& s) { return s.contact_force; });
-  d["mode"] = column(rows, [](const Snapshot& s) { return static_cast<double>(s.mode); });
-  d["tmd_x"] = column(rows, [](const Snapshot& s) { return s.tmd_x; });
-  d["tmd_v"] = column(rows, [](const Snapshot& s) { return s.tmd_v; });
+  for (const auto& [name, get] : kScalarFields) {
+    py::array_t<double> out(n);
+    auto o = out.mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < n; ++i) o(i) = get(rows[static_cast<std::size_t>(i)]);
+    d[name] = out;
+  }
+  for (const auto& [name, field] : kFloorFields) {
+    py::array_t<double> out({n, static_cast<py::ssize_t>(stories)});
+    auto o = out.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < n; ++i)
+      for (int j = 0; j < stories; ++j) o(i, j) = (rows[static_cast<std::size_t>(i)].*field)[static_cast<std::size_t>(j)];
+    d[name] = out;
+  }
   return d;
 }
 
@@ -244,21 +242,9 @@ py::array_t<double> floor_array(const FloorArray& a, int stories) {
 // One step's outputs (a Snapshot) as a dict.
 py::dict step_dict(const Snapshot& s, int stories) {
   py::dict d;
-  d["t"] = s.t;
-  d["ag"] = s.ag;
-  d["x"] = floor_array(s.x, stories);
-  d["v"] = floor_array(s.v, stories);
-  d["acc"] = floor_array(s.acc, stories);
-  d["drift"] = floor_array(s.drift, stories);
-  d["elastic_energy"] = s.elastic_energy;
-  d["particle_x"] = s.particle_x;
-  d["particle_v"] = s.particle_v;
-  d["wall_left"] = s.wall_left;
-  d["wall_right"] = s.wall_right;
-  d["contact_force"] = s.contact_force;
-  d["mode"] = s.mode;
-  d["tmd_x"] = s.tmd_x;
-  d["tmd_v"] = s.tmd_v;
+  for (const auto& [name, get] : kScalarFields) d[name] = get(s);
+  for (const auto& [name, field] : kFloorFields) d[name] = floor_array(s.*field, stories);
+  d["mode"] = s.mode;  // a step's mode stays the integer code (vines::Mode)
   return d;
 }
 
