@@ -8,7 +8,9 @@
 #include "vines/lti.hpp"
 
 namespace vines::host {
+namespace {
 
+// The modal data of a bare frame, from a built engine's model info.
 link::ModalData modal_data(const ModelInfo& info) {
   link::ModalData md;
   md.n = info.stories;
@@ -21,6 +23,8 @@ link::ModalData modal_data(const ModelInfo& info) {
   }
   return md;
 }
+
+}  // namespace
 
 std::vector<std::uint8_t> hybrid_image(const ModelInfo& info, double h) {
   const link::ModalData md = modal_data(info);

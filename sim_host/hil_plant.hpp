@@ -14,9 +14,6 @@
 
 namespace vines::host {
 
-// The modal data of a bare frame, from a built engine's model info.
-link::ModalData modal_data(const ModelInfo& info);
-
 // The hybrid frame image (link/hybrid_frame.hpp) of the bare frame's modes
 // at period h: what a hybrid node runs.
 std::vector<std::uint8_t> hybrid_image(const ModelInfo& info, double h);
