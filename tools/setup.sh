@@ -67,6 +67,10 @@ fi
 echo "setup ($set_name): installing ${missing[*]}"
 sudo=()
 if [[ $(id -u) -ne 0 ]]; then sudo=(sudo); fi
+# An install stopped half way (packages unpacked, not configured) makes every
+# apt-get install refuse ("dpkg was interrupted"): finish it first (no-op
+# otherwise).
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive dpkg --configure -a </dev/null
 "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q </dev/null
 # --force-unsafe-io: dpkg does not fsync every file it unpacks (as in Debian's
 # container images); on a fresh machine that is most of the install's time. A
