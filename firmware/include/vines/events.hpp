@@ -2,9 +2,10 @@
 // substep_bounded.hpp): the event functions of each contact mode, an event
 // due before any time passes, the first event inside a sub-step bracketed
 // on the cubic Hermite interpolant of its event function, and its root
-// placed either on the true sub-step (Newton / Illinois on trial steps,
-// substep_through) or on the interpolant (a fixed number of Newton steps,
-// substep_bounded). What an event does is the contact-mode state machine's
+// placed either on the true sub-step (found on the step's dense output, one
+// trial step there and a first-order polish, Newton / Illinois on trial
+// steps if that misses: substep_through) or on the interpolant (a fixed
+// number of Newton steps, substep_bounded). What an event does is the contact-mode state machine's
 // (contact_mode.hpp, apply_event in substep.hpp).
 #pragma once
 
@@ -117,28 +118,124 @@ VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, cons
   return any;
 }
 
+// The change of an event function along a direction v of the state (the
+// event functions of the walls, of q and of t are affine in the state).
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+VINES_INLINE S event_change(const Model<S, N, Dev>& m, const Stepper& st, const Vec& v, int side) {
+  constexpr int NX = Model<S, N, Dev>::kNx;
+  if (side == 0) return v(Stepper::kT);
+  if (in_contact(st.mode)) return -v(Stepper::kQ);
+  const S dr = v(NX) - m.dev_x(v.template head<NX>());
+  return side < 0 ? -dr : dr;
+}
+
+// An event function along a step's dense output: the dense output of the
+// step projected on it (g0 at the start, g1 at the end: an affine function
+// of the dense output is the dense output of its values), a quintic in
+// theta.
+template <typename S>
+struct DenseEvent {
+  numeric::Dopri5Dense<S> d;
+
+  // value and d/dtheta
+  S value(S th, S* slope) const {
+    const S th1 = S(1) - th;
+    const S a = d.c3 + th1 * d.c4, b = d.c2 + th * a, c = th1 * b;
+    const S db = a - th * d.c4, dc = th1 * db - b;
+    *slope = d.c1 + c + th * dc;
+    return d.y0 + th * (d.c1 + c);
+  }
+
+  // The first theta in (0, 1] where the quintic rises through `target`
+  // (value(0) <= target): a 16-point grid, then Newton steps kept inside the
+  // bracket (bisection where Newton would leave it) to rounding. False if
+  // the grid finds no crossing.
+  bool first_crossing(S target, S* theta) const {
+    constexpr int kGrid = 16;
+    S lo = S(0), hi = S(-1);
+    for (int i = 1; i <= kGrid; ++i) {
+      const S th = S(i) / S(kGrid);
+      if (d.at(th) > target) {
+        hi = th;
+        break;
+      }
+      lo = th;
+    }
+    if (hi < S(0)) return false;
+    S th = S(0.5) * (lo + hi);
+    for (int it = 0; it < 60; ++it) {
+      S slope;
+      const S g = value(th, &slope) - target;
+      if (g > S(0)) hi = th;
+      else lo = th;
+      S next = slope > S(0) ? th - g / slope : S(0.5) * (lo + hi);
+      if (!(next > lo && next < hi)) next = S(0.5) * (lo + hi);
+      if (next == th || hi - lo <= std::numeric_limits<S>::epsilon() * hi) break;
+      th = next;
+    }
+    *theta = hi;
+    return true;
+  }
+};
+
+// The event function of `side` (g0 at y, g1 at r.y) along the dense output
+// of the step r from (y, f) of length hs (not for a particle riding a wall:
+// its holding force is not affine in the state).
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+DenseEvent<S> dense_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& f,
+                          const numeric::Dopri5Result<Vec>& r, S hs, int side, S g0, S g1) {
+  numeric::Dopri5Result<S> p;
+  p.y = g1;
+  p.f = event_change(m, st, r.f, side);
+  p.k3 = event_change(m, st, r.k3, side);
+  p.k4 = event_change(m, st, r.k4, side);
+  p.k5 = event_change(m, st, r.k5, side);
+  p.k6 = event_change(m, st, r.k6, side);
+  return {numeric::dopri5_dense(p, g0, event_change(m, st, f, side), hs)};
+}
+
 // Places the event first_event found (side; theta its guess) on the true
-// sub-step from (y, f) at u, bracket [0, hs] (y1, f1: its end): Newton steps
-// on the event function (its slope comes with each trial step) aimed at the
-// middle of the acceptance band [0, tol], Illinois steps where Newton would
-// leave the bracket; at most 40. The step end (side 0) is placed to rounding
-// of t. Returns the trial step to the event, *tau its length.
+// sub-step r from (y, f) at u, of length hs. The acceptance band of the
+// event function is [0, tol] (the end of the sensor step, side 0: t within
+// rounding of h), aimed at its middle:
+//   1. the root on the step's dense output (DenseEvent);
+//   2. one trial step to it;
+//   3. its end moved onto the root by a first-order step along f (length
+//      dtau = -g / g'), which errs by dtau^2 y'' / 2: taken only while
+//      |dtau| <= 0.1 sqrt(rtol) hs, where that is below 0.005 rtol of the
+//      step's own curvature term; the dense output's error keeps dtau far
+//      smaller.
+// Where a step misses (no dense crossing, a riding particle, dtau too long,
+// still outside the band), Newton steps on trial steps (their slope comes
+// with each), Illinois steps where Newton would leave the bracket; at most
+// 40. Returns the step to the event, *tau_out its length.
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, const Stepper& st, S u, const Vec& y,
-                                                     const Vec& f, const Vec& y1, const Vec& f1, S hs, S h, S theta,
-                                                     int side, S* tau_out) {
+                                                     const Vec& f, const numeric::Dopri5Result<Vec>& r, S hs, S h,
+                                                     S theta, int side, S rtol, S* tau_out) {
   constexpr S kEps = std::numeric_limits<S>::epsilon();
   const S tol = side == 0 ? S(4) * kEps * h : m.dev.event_tol;
+  auto in_band = [&](S g) { return std::fabs(g) <= tol && g >= S(0); };
   S lo = S(0), hi = hs, slope;
   S glo = event_value(m, st, y, f, side, h, &slope);
-  S ghi = event_value(m, st, y1, f1, side, h, &slope);
+  S ghi = event_value(m, st, r.y, r.f, side, h, &slope);
+  S th;
+  if (!riding(st.mode) && dense_event(m, st, f, r, hs, side, glo, ghi).first_crossing(S(0.5) * tol, &th)) theta = th;
   if (!(ghi > S(0))) ghi = S(1);
   S tau = theta * hs;
   auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
+  S g = event_value(m, st, rr.y, rr.f, side, h, &slope);
+  if (!in_band(g) && slope > S(0)) {
+    const S dtau = -(g - S(0.5) * tol) / slope;
+    if (std::fabs(dtau) <= S(0.1) * std::sqrt(rtol) * hs && tau + dtau > S(0) && tau + dtau < hs) {
+      tau += dtau;
+      rr.y += dtau * rr.f;
+      rr.f = st(u + tau, rr.y);
+      g = event_value(m, st, rr.y, rr.f, side, h, &slope);
+    }
+  }
   int last = 0;
-  for (int it = 0; it < 40; ++it) {
-    const S g = event_value(m, st, rr.y, rr.f, side, h, &slope);
-    if (std::fabs(g) <= tol && g >= S(0)) break;
+  for (int it = 0; it < 40 && !in_band(g); ++it) {
     if (g > S(0)) { hi = tau; ghi = g; if (last == 1) glo *= S(0.5); last = 1; }
     else { lo = tau; glo = g; if (last == -1) ghi *= S(0.5); last = -1; }
     if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) {
@@ -151,6 +248,7 @@ VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, 
     }
     rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
     if (tau == hi && hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) break;
+    g = event_value(m, st, rr.y, rr.f, side, h, &slope);
   }
   *tau_out = tau;
   return rr;

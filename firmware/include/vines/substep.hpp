@@ -47,6 +47,10 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   // Tolerances that the scalar can honour.
   const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * kEps);
   const int cap = m.loop.max_substeps_per_step;
+  // q and the overlap agree within rtol * pos_scale (they are put back
+  // together past that, below): a contact ends where q reaches zero with no
+  // more overlap left than that (apply_event).
+  const S end_tol = numeric::max_of(dm.event_tol, rtol * dm.pos_scale);
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
   const Eigen::Array<S, NX + 2, 1> rtol_scale = rtol * Stepper::error_scale(m);
@@ -70,7 +74,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
         ++immediate;
         ++d.count.events;
         const bool was_regular = st.regular();
-        apply_event(m, d, st, y, due);
+        apply_event(m, d, st, y, due, end_tol);
         if (st.regular() && !was_regular) hc_w = dm.w_step0;
         f = st(u, y);
         continue;
@@ -103,7 +107,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     if (any && theta <= S(1)) {
       // Place the event on the true sub-step (detail::locate_event).
       S tau;
-      const auto rr = detail::locate_event(m, st, u, y, f, r.y, r.f, hs, h, theta, side, &tau);
+      const auto rr = detail::locate_event(m, st, u, y, f, r, hs, h, theta, side, rtol, &tau);
       // Accept up to the event.
       track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), d.time(m) + static_cast<double>(rr.y(kT)));
       u += tau;
@@ -116,7 +120,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
       }
       ++d.count.events;
       const bool was_regular = st.regular();
-      apply_event(m, d, st, y, side);
+      apply_event(m, d, st, y, side, end_tol);
       if (st.regular() && !was_regular) hc_w = dm.w_step0;
       f = st(u, y);
       continue;

@@ -105,7 +105,7 @@ struct SubStepper {
 
   // y' (free, stuck) or dy/dw (contact). The frame is written straight from
   // the modal coefficients, every rate scaled by w = dt/du once.
-  Vec operator()(S /*u*/, const Vec& y) const {
+  void operator()(S /*u*/, const Vec& y, Vec* out) const {
     constexpr int P = NX / 2;
     const auto& l = m.lti;
     const auto& dm = m.dev;
@@ -115,7 +115,7 @@ struct SubStepper {
     const S w = regular() ? S(4) * y(kQ) * y(kQ) * y(kQ) : S(1);
     const auto q = y.template head<P>().array();
     const auto v = y.template segment<P>(P).array();
-    Vec dy;
+    Vec& dy = *out;
     dy.template head<P>() = w * v;
     dy.template segment<P>(P) =
         w * (l.ak.array() * q + l.ac.array() * v + (l.bgv.array() * a - l.bfv.array() * fp));
@@ -133,6 +133,10 @@ struct SubStepper {
     dy(NX + 5) = w * m.strain.eval_positions(y.template head<P>());
     dy(kT) = w;
     dy(kQ) = dq;
+  }
+  Vec operator()(S u, const Vec& y) const {
+    Vec dy;
+    (*this)(u, y, &dy);
     return dy;
   }
 
