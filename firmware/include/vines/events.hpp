@@ -5,8 +5,9 @@
 // placed either on the true sub-step (found on the step's dense output, one
 // trial step there and a first-order polish, Newton / Illinois on trial
 // steps if that misses: substep_through) or on the interpolant (a fixed
-// number of Newton steps, substep_bounded). What an event does is the contact-mode state machine's
-// (contact_mode.hpp, apply_event in substep.hpp).
+// number of Newton steps, substep_bounded). What an event does is the
+// contact-mode state machine's (contact_mode.hpp, apply_event in
+// substep.hpp).
 #pragma once
 
 #include <cmath>

@@ -103,8 +103,9 @@ struct SubStepper {
     }
   }
 
-  // y' (free, stuck) or dy/dw (contact). The frame is written straight from
-  // the modal coefficients, every rate scaled by w = dt/du once.
+  // y' (free, stuck) or dy/dw (contact) into *out (not y itself). The frame
+  // is written straight from the modal coefficients, every rate scaled by
+  // w = dt/du once.
   void operator()(S /*u*/, const Vec& y, Vec* out) const {
     constexpr int P = NX / 2;
     const auto& l = m.lti;
@@ -134,6 +135,7 @@ struct SubStepper {
     dy(kT) = w;
     dy(kQ) = dq;
   }
+  // The same, returned.
   Vec operator()(S u, const Vec& y) const {
     Vec dy;
     (*this)(u, y, &dy);
