@@ -130,58 +130,59 @@ VINES_INLINE S event_change(const Model<S, N, Dev>& m, const Stepper& st, const 
   return side < 0 ? -dr : dr;
 }
 
-// An event function along a step's dense output: the dense output of the
-// step projected on it (g0 at the start, g1 at the end: an affine function
-// of the dense output is the dense output of its values), a quintic in
-// theta.
+// kIterations Newton steps on the curve c (value(theta), slope(theta): a
+// cubic interpolant, a DenseEvent) from theta, kept inside [lo, hi] where c
+// rises through zero (bisection where Newton would leave it): an event
+// placed on a sub-step's interpolant, with a fixed worst case.
+template <int kIterations, typename Curve, typename S>
+S polish_root(const Curve& c, S theta, S lo, S hi) {
+  for (int it = 0; it < kIterations; ++it) {
+    const S v = c.value(theta);
+    if (v > S(0)) hi = theta;
+    else lo = theta;
+    const S slope = c.slope(theta);
+    S next = slope > S(0) ? theta - v / slope : S(0.5) * (lo + hi);
+    if (!(next >= lo && next <= hi)) next = S(0.5) * (lo + hi);
+    if (next == theta) break;
+    theta = next;
+  }
+  return theta;
+}
+
+// An event function less its target along a step's dense output: the
+// dense output of the step projected on it (an affine function of the
+// dense output is the dense output of its values), a quintic in theta.
 template <typename S>
 struct DenseEvent {
   numeric::Dopri5Dense<S> d;
 
-  // value and d/dtheta
-  S value(S th, S* slope) const {
+  S value(S th) const { return d.at(th); }
+  S slope(S th) const {  // d/dtheta
     const S th1 = S(1) - th;
-    const S a = d.c3 + th1 * d.c4, b = d.c2 + th * a, c = th1 * b;
-    const S db = a - th * d.c4, dc = th1 * db - b;
-    *slope = d.c1 + c + th * dc;
-    return d.y0 + th * (d.c1 + c);
+    const S a = d.c3 + th1 * d.c4, b = d.c2 + th * a;
+    return d.c1 + th1 * b + th * (th1 * (a - th * d.c4) - b);
   }
 
-  // The first theta in (0, 1] where the quintic rises through `target`
-  // (value(0) <= target): a 16-point grid, then Newton steps kept inside the
-  // bracket (bisection where Newton would leave it) to rounding. False if
-  // the grid finds no crossing.
-  bool first_crossing(S target, S* theta) const {
+  // The first theta in (0, 1] where it rises through zero (value(0) <= 0):
+  // a 16-point grid, then Newton steps inside the bracket to rounding
+  // (polish_root). False if the grid finds no crossing.
+  bool first_crossing(S* theta) const {
     constexpr int kGrid = 16;
-    S lo = S(0), hi = S(-1);
     for (int i = 1; i <= kGrid; ++i) {
-      const S th = S(i) / S(kGrid);
-      if (d.at(th) > target) {
-        hi = th;
-        break;
+      const S hi = S(i) / S(kGrid);
+      if (value(hi) > S(0)) {
+        const S lo = S(i - 1) / S(kGrid);
+        *theta = polish_root<60>(*this, S(0.5) * (lo + hi), lo, hi);
+        return true;
       }
-      lo = th;
     }
-    if (hi < S(0)) return false;
-    S th = S(0.5) * (lo + hi);
-    for (int it = 0; it < 60; ++it) {
-      S slope;
-      const S g = value(th, &slope) - target;
-      if (g > S(0)) hi = th;
-      else lo = th;
-      S next = slope > S(0) ? th - g / slope : S(0.5) * (lo + hi);
-      if (!(next > lo && next < hi)) next = S(0.5) * (lo + hi);
-      if (next == th || hi - lo <= std::numeric_limits<S>::epsilon() * hi) break;
-      th = next;
-    }
-    *theta = hi;
-    return true;
+    return false;
   }
 };
 
-// The event function of `side` (g0 at y, g1 at r.y) along the dense output
-// of the step r from (y, f) of length hs (not for a particle riding a wall:
-// its holding force is not affine in the state).
+// The event function of `side` less its target (g0 at y, g1 at r.y) along
+// the dense output of the step r from (y, f) of length hs (not for a
+// particle riding a wall: its holding force is not affine in the state).
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 DenseEvent<S> dense_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& f,
                           const numeric::Dopri5Result<Vec>& r, S hs, int side, S g0, S g1) {
@@ -220,14 +221,15 @@ VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, 
   S lo = S(0), hi = hs, slope;
   S glo = event_value(m, st, y, f, side, h, &slope);
   S ghi = event_value(m, st, r.y, r.f, side, h, &slope);
+  const S aim = S(0.5) * tol;
   S th;
-  if (!riding(st.mode) && dense_event(m, st, f, r, hs, side, glo, ghi).first_crossing(S(0.5) * tol, &th)) theta = th;
+  if (!riding(st.mode) && dense_event(m, st, f, r, hs, side, glo - aim, ghi - aim).first_crossing(&th)) theta = th;
   if (!(ghi > S(0))) ghi = S(1);
   S tau = theta * hs;
   auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
   S g = event_value(m, st, rr.y, rr.f, side, h, &slope);
   if (!in_band(g) && slope > S(0)) {
-    const S dtau = -(g - S(0.5) * tol) / slope;
+    const S dtau = -(g - aim) / slope;
     if (std::fabs(dtau) <= S(0.1) * std::sqrt(rtol) * hs && tau + dtau > S(0) && tau + dtau < hs) {
       tau += dtau;
       rr.y += dtau * rr.f;
@@ -242,7 +244,7 @@ VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, 
     if (hi - lo <= S(4) * kEps * (std::fabs(u) + hi)) {
       tau = hi;
     } else {
-      tau = slope > S(0) ? tau - (g - S(0.5) * tol) / slope : lo;
+      tau = slope > S(0) ? tau - (g - aim) / slope : lo;
       if (!(tau > lo && tau < hi))
         tau = (ghi > S(0) && glo < S(0)) ? (lo * ghi - hi * glo) / (ghi - glo) : S(0.5) * (lo + hi);
       if (!(tau > lo && tau < hi)) tau = S(0.5) * (lo + hi);
@@ -253,24 +255,6 @@ VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, 
   }
   *tau_out = tau;
   return rr;
-}
-
-// kIterations Newton steps on the cubic c from theta, kept inside [lo, hi]
-// where c rises through zero (bisection where Newton would leave it): an
-// event placed on a sub-step's interpolant, with a fixed worst case.
-template <int kIterations, typename S>
-S polish_root(const numeric::Cubic<S>& c, S theta, S lo, S hi) {
-  for (int it = 0; it < kIterations; ++it) {
-    const S v = c.value(theta);
-    if (v > S(0)) hi = theta;
-    else lo = theta;
-    const S slope = c.slope(theta);
-    S next = slope > S(0) ? theta - v / slope : S(0.5) * (lo + hi);
-    if (!(next >= lo && next <= hi)) next = S(0.5) * (lo + hi);
-    if (next == theta) break;
-    theta = next;
-  }
-  return theta;
 }
 
 }  // namespace detail
