@@ -28,9 +28,10 @@ namespace vines {
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
   const auto& dm = m.dev;
-  const S r = st.rel_pos(y), rd = st.rel_vel(y), tol = m.dev.event_tol;
+  const S tol = m.dev.event_tol;
   switch (st.mode) {
     case Mode::kFree: {
+      const S r = st.rel_pos(y), rd = st.rel_vel(y);
       // An impact needs an approach speed the law resolves (a particle just
       // released from a wall sits on it with a rounding-level speed).
       const S v_min = Dev::kLaw == ContactLaw::kRestitution ? static_cast<S>(kStickSpeed) : S(0);
@@ -71,11 +72,12 @@ VINES_INLINE S event_value(const Model<S, N, Dev>& m, const Stepper& st, const V
     *slope = f(kT);
     return y(kT) - h;
   }
-  const S r = st.rel_pos(y), rd = st.rel_vel(y);
   switch (st.mode) {
-    case Mode::kFree:  // overlap with wall `side` exceeds the tolerance
+    case Mode::kFree: {  // overlap with wall `side` exceeds the tolerance
+      const S r = st.rel_pos(y), rd = st.rel_vel(y);
       *slope = side < 0 ? -rd : rd;
       return (side < 0 ? overlap_left<S>(dm, r) : overlap_right<S>(dm, r)) - m.dev.event_tol;
+    }
     case Mode::kContactLeft:  // q returns to zero
     case Mode::kContactRight:
       *slope = -f(kQ);
