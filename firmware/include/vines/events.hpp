@@ -166,19 +166,13 @@ struct DenseEvent {
   }
 
   // The first theta in (0, 1] where it rises through zero (value(0) <= 0):
-  // a 16-point grid, then Newton steps inside the bracket to rounding
-  // (polish_root). False if the grid finds no crossing.
+  // a 16-point grid (numeric::grid_upcrossing), then Newton steps inside the
+  // bracket to rounding (polish_root). False if the grid finds no crossing.
   bool first_crossing(S* theta) const {
-    constexpr int kGrid = 16;
-    for (int i = 1; i <= kGrid; ++i) {
-      const S hi = S(i) / S(kGrid);
-      if (value(hi) > S(0)) {
-        const S lo = S(i - 1) / S(kGrid);
-        *theta = polish_root<60>(*this, S(0.5) * (lo + hi), lo, hi);
-        return true;
-      }
-    }
-    return false;
+    S lo, hi;
+    if (!numeric::grid_upcrossing(*this, d.y0, &lo, &hi)) return false;
+    *theta = polish_root<60>(*this, S(0.5) * (lo + hi), lo, hi);
+    return true;
   }
 };
 

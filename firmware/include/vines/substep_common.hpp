@@ -289,12 +289,6 @@ VINES_NOINLINE void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S
   take_event(st.mode, side, Dev::kLaw == ContactLaw::kRestitution, act);
 }
 
-// The same, with the event tolerance for the end of a contact.
-template <typename S, int N, typename Dev, typename Stepper, typename Vec>
-void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side) {
-  apply_event(m, d, st, y, side, m.dev.event_tol);
-}
-
 namespace detail {
 
 // The sub-steppers' state vector from the data block: floors (modal), the

@@ -54,25 +54,38 @@ struct Cubic {
   // value(0) <= 0: bracketing on a fine grid, then `halvings` bisections
   // (60: to rounding; a caller that refines the root itself needs fewer).
   // Returns 1 if none is found (the caller re-checks with the true solution).
-  S first_upcrossing(int halvings = 60) const {
-    constexpr int kGrid = 16;
-    S lo = S(0), flo = y0;
-    for (int i = 1; i <= kGrid; ++i) {
-      const S hi = S(i) / S(kGrid), fhi = value(hi);
-      if (fhi > S(0) && flo <= S(0)) {
-        S a = lo, b = hi;
-        for (int it = 0; it < halvings; ++it) {
-          const S m = S(0.5) * (a + b);
-          if (value(m) > S(0)) b = m; else a = m;
-        }
-        return b;
-      }
-      lo = hi;
-      flo = fhi;
-    }
-    return S(1);
-  }
+  S first_upcrossing(int halvings = 60) const;
 };
+
+// The first cell [*lo, *hi] of a 16-point grid on [0, 1] where the curve c
+// (c.value(theta), f0 = its value at 0) rises through zero; false if none.
+template <typename Curve, typename S>
+bool grid_upcrossing(const Curve& c, S f0, S* lo, S* hi) {
+  constexpr int kGrid = 16;
+  S a = S(0), fa = f0;
+  for (int i = 1; i <= kGrid; ++i) {
+    const S b = S(i) / S(kGrid), fb = c.value(b);
+    if (fb > S(0) && fa <= S(0)) {
+      *lo = a;
+      *hi = b;
+      return true;
+    }
+    a = b;
+    fa = fb;
+  }
+  return false;
+}
+
+template <typename S>
+S Cubic<S>::first_upcrossing(int halvings) const {
+  S a, b;
+  if (!grid_upcrossing(*this, y0, &a, &b)) return S(1);
+  for (int it = 0; it < halvings; ++it) {
+    const S m = S(0.5) * (a + b);
+    if (value(m) > S(0)) b = m; else a = m;
+  }
+  return b;
+}
 
 // The cubic Hermite interpolant of a vector function on [0, h] (values y0,
 // y1 and derivatives f0, f1 at the ends) at theta = t / h (also outside [0, 1]).
