@@ -252,7 +252,7 @@ std::string format_table(const std::vector<BenchLine>& lines) {
     if (l.method == "firmware")
       std::snprintf(scheme, sizeof scheme, l.scheme == "bounded" ? "bounded/%d" : "adaptive", l.bounded_substeps);
     std::snprintf(buf, sizeof buf,
-                  "%-26s %-12s %-10s %-6s %8.0f %7.0e %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
+                  "%-26s %-12s %-10s %-6s %8.0f %7.3g %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
                   l.scene.c_str(), l.method.c_str(), scheme, l.scalar.c_str(), l.rate_hz, l.rtol,
                   1e3 * l.wall_median_s, l.runs, l.steps, l.substeps, l.max_substeps_in_step, l.peak_rel_error,
                   l.elastic_energy_rel_error, l.x_r_abs_error, l.contacts);
