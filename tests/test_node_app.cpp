@@ -103,6 +103,30 @@ link::NodeConfig config_of(const SceneParams& p) {
   return c;
 }
 
+// The host node's plant configured as a session does it: the image, then
+// the settings (the reason of a refusal as the failure message).
+::testing::AssertionResult configure_host(host::HostPlant* h, const std::vector<std::uint8_t>& img,
+                                          const link::NodeConfig& c) {
+  h->image_begin(static_cast<std::uint32_t>(img.size()));
+  h->image_push(img.data(), img.size());
+  char msg[128] = {};
+  if (h->configure(c, msg, sizeof msg)) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << msg;
+}
+
+// The host plant's telemetry over samples a[k] (forces f[k]; none: 0).
+std::vector<link::Telemetry> host_run(host::HostPlant* h, const std::vector<double>& a,
+                                      const std::vector<double>& f = {}) {
+  std::vector<link::Telemetry> out(a.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const double fk = f.empty() ? 0.0 : f[k];
+    if (k == 0) h->init(a[0], fk);
+    else h->step(a[k], fk);
+    h->read(&out[k]);
+  }
+  return out;
+}
+
 // The board's node: static-sized blocks, here on the heap of the test.
 struct BoardNode {
   std::unique_ptr<Model<double, 10, Kuwabara>> model = std::make_unique<Model<double, 10, Kuwabara>>();
@@ -128,18 +152,12 @@ TEST(NodeApp, BoardNodeOnAnImageStepsAsTheHostNode) {
 
   // The host node's plant: the engine of the same scene, built in place.
   host::HostPlant host;
-  const std::vector<std::uint8_t> img = image_of<Kuwabara>(p);
-  host.image_begin(static_cast<std::uint32_t>(img.size()));
-  host.image_push(img.data(), img.size());
-  char msg[64] = {};
-  ASSERT_TRUE(host.configure(config_of(p), msg, sizeof msg)) << msg;
+  ASSERT_TRUE(configure_host(&host, image_of<Kuwabara>(p), config_of(p)));
+  const std::vector<link::Telemetry> ht = host_run(&host, a);
   double worst = 0, peak = 0;
   int contacts = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    link::Telemetry t;
-    if (k == 0) host.init(a[0], 0);
-    else host.step(a[k], 0);
-    host.read(&t);
+    const link::Telemetry& t = ht[k];
     const link::Telemetry& n = b.out.tel[k];
     ASSERT_EQ(n.k, k);
     for (int i = 0; i < 10; ++i) worst = std::fmax(worst, std::fabs(n.x[i] - t.x[i]));
@@ -254,16 +272,11 @@ TEST(NodeApp, BoardNodeRunsTheHybridFrameAsTheHostNode) {
   ASSERT_EQ(b.out.tel.size(), a.size());
 
   host::HostPlant host;
-  host.image_begin(static_cast<std::uint32_t>(img.size()));
-  host.image_push(img.data(), img.size());
-  char msg[80] = {};
-  ASSERT_TRUE(host.configure(c, msg, sizeof msg)) << msg;
+  ASSERT_TRUE(configure_host(&host, img, c));
+  const std::vector<link::Telemetry> ht = host_run(&host, a, f);
   double worst = 0, peak = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    link::Telemetry t;
-    if (k == 0) host.init(a[0], f[0]);
-    else host.step(a[k], f[k]);
-    host.read(&t);
+    const link::Telemetry& t = ht[k];
     for (int i = 0; i < 10; ++i) worst = std::fmax(worst, std::fabs(b.out.tel[k].x[i] - t.x[i]));
     peak = std::fmax(peak, std::fabs(t.x[9]));
   }
@@ -278,17 +291,12 @@ TEST(NodeApp, BoardNodeRunsTheHybridFrameAsTheHostNode) {
   z.bench.run(a);
   SceneParams bare = p;
   bare.device.kind = DeviceKind::kNone;
-  const std::vector<std::uint8_t> bare_img = image_of<NoDevice>(bare);
   host::HostPlant ref;
-  ref.image_begin(static_cast<std::uint32_t>(bare_img.size()));
-  ref.image_push(bare_img.data(), bare_img.size());
-  ASSERT_TRUE(ref.configure(config_of(bare), msg, sizeof msg)) << msg;
+  ASSERT_TRUE(configure_host(&ref, image_of<NoDevice>(bare), config_of(bare)));
+  const std::vector<link::Telemetry> rt = host_run(&ref, a);
   worst = peak = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
-    link::Telemetry t;
-    if (k == 0) ref.init(a[0], 0);
-    else ref.step(a[k], 0);
-    ref.read(&t);
+    const link::Telemetry& t = rt[k];
     for (int i = 0; i < 10; ++i) worst = std::fmax(worst, std::fabs(z.out.tel[k].x[i] - t.x[i]));
     peak = std::fmax(peak, std::fabs(t.x[9]));
   }
