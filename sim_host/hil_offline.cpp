@@ -30,9 +30,7 @@ std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std:
   for (std::size_t i = 0; i + 1 < from.size(); ++i) {
     HostPlant plant;
     char msg[64] = {};
-    plant.image_begin(static_cast<std::uint32_t>(image.size()));
-    plant.image_push(image.data(), image.size());
-    if (!plant.configure(cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
+    if (!plant.load(image, cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
     const auto k0 = static_cast<std::size_t>(from[i]);
     plant.init(samples[k0], 0);
     plant.read(&out[k0]);

@@ -61,6 +61,16 @@ const char* HostPlant::image_push(const std::uint8_t* p, std::size_t n) {
   return nullptr;
 }
 
+bool HostPlant::load(const std::vector<std::uint8_t>& image, const link::NodeConfig& c, char* msg,
+                     std::size_t cap) {
+  if (const char* why = image_begin(static_cast<std::uint32_t>(image.size()))) {
+    std::snprintf(msg, cap, "%s", why);
+    return false;
+  }
+  image_push(image.data(), image.size());
+  return configure(c, msg, cap);
+}
+
 bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap) {
   mode_ = c.mode;
   n_ = c.scene.frame.stories;

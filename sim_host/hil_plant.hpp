@@ -27,6 +27,9 @@ class HostPlant {
   const char* image_push(const std::uint8_t* p, std::size_t n);
   const char* image_finish() { return nullptr; }  // checked at configure, by the engine
   bool configure(const link::NodeConfig& c, char* msg, std::size_t cap);
+  // A whole image then the settings, as a session sends them (offline runs,
+  // tests): false with the reason in msg if either is refused.
+  bool load(const std::vector<std::uint8_t>& image, const link::NodeConfig& c, char* msg, std::size_t cap);
   void init(double a0, double f0);
   void step(double a1, double f1);
   void read(link::Telemetry* t);

@@ -103,17 +103,6 @@ link::NodeConfig config_of(const SceneParams& p) {
   return c;
 }
 
-// The host node's plant configured as a session does it: the image, then
-// the settings (the reason of a refusal as the failure message).
-::testing::AssertionResult configure_host(host::HostPlant* h, const std::vector<std::uint8_t>& img,
-                                          const link::NodeConfig& c) {
-  h->image_begin(static_cast<std::uint32_t>(img.size()));
-  h->image_push(img.data(), img.size());
-  char msg[128] = {};
-  if (h->configure(c, msg, sizeof msg)) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << msg;
-}
-
 // The host plant's telemetry over samples a[k] (forces f[k]; none: 0).
 std::vector<link::Telemetry> host_run(host::HostPlant* h, const std::vector<double>& a,
                                       const std::vector<double>& f = {}) {
@@ -152,7 +141,8 @@ TEST(NodeApp, BoardNodeOnAnImageStepsAsTheHostNode) {
 
   // The host node's plant: the engine of the same scene, built in place.
   host::HostPlant host;
-  ASSERT_TRUE(configure_host(&host, image_of<Kuwabara>(p), config_of(p)));
+  char msg[128] = {};
+  ASSERT_TRUE(host.load(image_of<Kuwabara>(p), config_of(p), msg, sizeof msg)) << msg;
   const std::vector<link::Telemetry> ht = host_run(&host, a);
   double worst = 0, peak = 0;
   int contacts = 0;
@@ -272,7 +262,8 @@ TEST(NodeApp, BoardNodeRunsTheHybridFrameAsTheHostNode) {
   ASSERT_EQ(b.out.tel.size(), a.size());
 
   host::HostPlant host;
-  ASSERT_TRUE(configure_host(&host, img, c));
+  char msg[128] = {};
+  ASSERT_TRUE(host.load(img, c, msg, sizeof msg)) << msg;
   const std::vector<link::Telemetry> ht = host_run(&host, a, f);
   double worst = 0, peak = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
@@ -292,7 +283,7 @@ TEST(NodeApp, BoardNodeRunsTheHybridFrameAsTheHostNode) {
   SceneParams bare = p;
   bare.device.kind = DeviceKind::kNone;
   host::HostPlant ref;
-  ASSERT_TRUE(configure_host(&ref, image_of<NoDevice>(bare), config_of(bare)));
+  ASSERT_TRUE(ref.load(image_of<NoDevice>(bare), config_of(bare), msg, sizeof msg)) << msg;
   const std::vector<link::Telemetry> rt = host_run(&ref, a);
   worst = peak = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
