@@ -21,9 +21,12 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
   const Bench b = make_bench(scene, opt);
   // What the node's telemetry is compared with: the offline run of the scene
   // (hybrid: the pure simulation, the device in the model).
+  // (twin estimator: the estimator on the same measurements).
   link::NodeConfig offline_cfg = b.cfg;
-  offline_cfg.mode = link::NodeMode::kReplay;
-  const std::vector<link::Telemetry> offline = offline_run(offline_cfg, b.ex.samples, b.scene.path);
+  const bool estimator = b.cfg.estimator != link::TwinEstimator::kNone;
+  if (!estimator) offline_cfg.mode = link::NodeMode::kReplay;
+  const TwinInputs twin = estimator ? TwinInputs{&b.image, &b.twin.y} : TwinInputs{};
+  const std::vector<link::Telemetry> offline = offline_run(offline_cfg, b.ex.samples, b.scene.path, {}, twin);
   // The mode's inputs (twin: the measured building; hybrid: the lab).
   const std::unique_ptr<BenchMode> mode = make_mode(b, offline);
   // Which faults hit which samples, drawn from the seed.
@@ -36,11 +39,12 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
     if (e.kind == FaultKind::kRestart) restarts.push_back(e.k);
   const std::vector<link::Telemetry> lives = restarts.empty()
                                                  ? std::vector<link::Telemetry>{}
-                                                 : offline_run(offline_cfg, b.ex.samples, b.scene.path, restarts);
+                                                 : offline_run(offline_cfg, b.ex.samples, b.scene.path, restarts, twin);
   // Its score, the mode's results and the CSV.
   HilReport report = score(b, rec, offline, restarts.empty() ? offline : lives, &events);
   mode->report(rec, offline, &report);
-  if (!b.opt.csv.empty()) write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h);
+  if (!b.opt.csv.empty())
+    write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec));
   return report;
 }
 

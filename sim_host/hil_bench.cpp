@@ -41,6 +41,22 @@ void check_specimen(const Scene& sc) {
                              ": the table plays the top floor (0 or " + std::to_string(n) + ")");
 }
 
+// Another mode's options are refused, not ignored.
+void check_mode_options(const HilOptions& o) {
+  const HilOptions d;
+  if (o.mode != HilMode::kTwin) {
+    const char* given = !o.truth_path.empty()                        ? "--truth"
+                        : !o.sensors.empty()                         ? "--sensors"
+                        : o.measure_noise_mps2 != d.measure_noise_mps2 ? "--measure-noise"
+                        : o.measure_noise_pct != d.measure_noise_pct ? "--measure-noise-pct"
+                        : o.measure_bias_mps2 != d.measure_bias_mps2 ? "--measure-bias"
+                        : o.adc_lsb_mps2 != d.adc_lsb_mps2           ? "--adc-lsb"
+                        : o.truth_stiffness_scale != d.truth_stiffness_scale ? "--truth-stiffness-scale"
+                                                                             : nullptr;
+    if (given) throw std::runtime_error(std::string(given) + ": a twin option (--mode twin)");
+  }
+}
+
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
 
 // The node: the host's `vines node` or a board in QEMU (its image, scalar and
@@ -73,6 +89,7 @@ link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   for (int i = 0; i < scene.params.frame.stories; ++i) c.drift_limit_m[i] = opt.drift_limit_m;
   c.residual_limit_mps2 = opt.residual_limit_mps2;
   c.residual_window_s = opt.residual_window_s;
+  if (opt.mode == HilMode::kTwin && opt.estimator == HilEstimator::kKalman) c.estimator = link::TwinEstimator::kKalman;
   constexpr link::CompKind kinds[] = {link::CompKind::kNone, link::CompKind::kPolynomial, link::CompKind::kAdaptive};
   c.comp_kind = kinds[static_cast<int>(opt.comp)];
   c.comp_delay_s = opt.comp_delay_s;
@@ -101,6 +118,7 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   // and the command's hold over a period (h / 2).
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
+  check_mode_options(o);
   if (hybrid) check_specimen(sc);
   if (hybrid && o.comp_delay_s < 0)
     o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz) + 0.5 * b.h;
@@ -114,7 +132,8 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
     throw std::runtime_error(why);
   }
   b.cfg = node_config(sc, o);
-  b.image = model_image(b.cfg, sc.path);
+  if (o.mode == HilMode::kTwin) b.twin = make_twin_bench(sc, o, b.ex);
+  b.image = b.cfg.estimator == link::TwinEstimator::kKalman ? b.twin.design.image : model_image(b.cfg, sc.path);
   return b;
 }
 

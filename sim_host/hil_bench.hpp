@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim_host/hil_boards.hpp"
+#include "sim_host/hil_twin.hpp"
 #include "sim_host/hil_options.hpp"
 #include "sim_host/run.hpp"
 #include "sim_host/scene.hpp"
@@ -22,7 +23,8 @@ struct Bench {
   long long samples = 0;
   double h = 0;                  // sensor period [s]
   link::NodeConfig cfg;          // what the node is configured with
-  std::vector<std::uint8_t> image;  // its model image (none in hybrid mode)
+  std::vector<std::uint8_t> image;  // its model image (hybrid: the hybrid frame's; twin kalman: the twin image)
+  TwinBench twin;                   // twin mode: the truth, the sensors' readings, the estimator's design
 };
 
 // Throws std::runtime_error naming the input (scene, option, node).

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
-#include <random>
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/hil_lab.hpp"
@@ -18,57 +17,6 @@ using link::Telemetry;
 
 // Replay: the node's plant is the scene; nothing to add.
 class ReplayMode : public BenchMode {};
-
-// Twin: the node's twin (the nominal model) is fed the top-floor acceleration
-// of the measured building (stiffness scaled by eta_k, sensor noise added).
-class TwinMode : public BenchMode {
- public:
-  explicit TwinMode(const Bench& b) : b_(b) {
-    link::NodeConfig truth = b.cfg;
-    truth.mode = link::NodeMode::kReplay;
-    truth.scene.frame.stiffness_scale *= b.opt.truth_stiffness_scale;
-    const std::vector<Telemetry> t = offline_run(truth, b.ex.samples, "--truth-stiffness-scale");
-    std::mt19937_64 rng(b.opt.seed + 17);
-    std::normal_distribution<double> noise(0.0, 1.0);
-    for (const Telemetry& r : t) measured_.push_back(r.acc_top + b.opt.measure_noise_mps2 * noise(rng));
-  }
-
-  double aux(long long k, const HilRecord&) const override { return measured_[static_cast<std::size_t>(k)]; }
-
-  // The residual the twin reports, its alarms and the drift alarms' stories.
-  void report(const HilRecord& rec, const std::vector<Telemetry>&, HilReport* r) const override {
-    HilTwinReport tw;
-    double ss = 0;
-    long long used = 0;
-    std::uint64_t stories = 0;
-    for (long long k = 0; k < rec.samples; ++k) {
-      if (!rec.got[k]) continue;
-      const Telemetry& t = rec.tel[k];
-      if (!(t.flags & link::kAuxMissing))
-        ss += t.aux * t.aux, ++used, tw.residual_max_mps2 = std::max(tw.residual_max_mps2, std::fabs(t.aux));
-      if (t.flags & link::kResidualAlarm) {
-        ++tw.residual_alarm_steps;
-        if (!tw.first_residual_alarm_s) tw.first_residual_alarm_s = static_cast<double>(k) * b_.h;
-      }
-      if (t.flags & link::kDriftAlarm) {
-        ++tw.drift_alarm_steps;
-        stories |= t.drift_alarms;
-        if (!tw.first_drift_alarm_s) tw.first_drift_alarm_s = static_cast<double>(k) * b_.h;
-      }
-    }
-    for (int i = 0; i < b_.scene.params.frame.stories; ++i)
-      if (stories >> i & 1) tw.stories_alarmed.push_back(i + 1);
-    tw.truth_stiffness_scale = b_.opt.truth_stiffness_scale;
-    tw.residual_rms_mps2 = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
-    tw.residual_limit_mps2 = b_.opt.residual_limit_mps2;
-    tw.drift_limit_m = b_.opt.drift_limit_m;
-    r->twin = tw;
-  }
-
- private:
-  const Bench& b_;
-  std::vector<double> measured_;  // the measured building's top-floor acceleration
-};
 
 // Hybrid: the node's bare frame commands the table (its top floor's motion);
 // the lab moves the table with the scene's device on it (VI NES or TMD), and
@@ -208,7 +156,7 @@ class HybridMode : public BenchMode {
 
 std::unique_ptr<BenchMode> make_mode(const Bench& b, const std::vector<Telemetry>& offline) {
   switch (b.opt.mode) {
-    case HilMode::kTwin: return std::make_unique<TwinMode>(b);
+    case HilMode::kTwin: return make_twin_mode(b);
     case HilMode::kHybrid: return std::make_unique<HybridMode>(b, offline[0]);
     default: return std::make_unique<ReplayMode>();
   }

@@ -24,15 +24,23 @@ class BenchMode {
   virtual double aux(long long /*k*/, const HilRecord& /*rec*/) const { return 0.0; }
   // The measured table displacement in sample k's frame (hybrid only).
   virtual double table_x(long long /*k*/, const HilRecord& /*rec*/) const { return 0.0; }
+  // The measured floor accelerations in sample k's frame (twin estimator);
+  // their count.
+  virtual int floors(long long /*k*/, double* /*y*/) const { return 0; }
   // Telemetry of the run came back (hybrid: the table's next command).
   virtual void on_telemetry(const link::Telemetry& /*t*/) {}
   // The mode's part of the report.
   virtual void report(const HilRecord& /*rec*/, const std::vector<link::Telemetry>& /*offline*/,
                       HilReport* /*r*/) const {}
+  // The mode's own columns of --csv (none by default).
+  virtual CsvColumns csv_columns(const HilRecord& /*rec*/) const { return {}; }
 };
 
 // The bench's mode set up: twin runs the measured building, hybrid builds the
 // lab from the offline run's initial state.
 std::unique_ptr<BenchMode> make_mode(const Bench& b, const std::vector<link::Telemetry>& offline);
+
+// The twin mode (hil_twin_mode.cpp).
+std::unique_ptr<BenchMode> make_twin_mode(const Bench& b);
 
 }  // namespace vines::host

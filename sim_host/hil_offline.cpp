@@ -18,8 +18,10 @@ std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::st
 }
 
 std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
-                                         const std::string& what, const std::vector<long long>& starts) {
-  const std::vector<std::uint8_t> image = model_image(cfg, what);
+                                         const std::string& what, const std::vector<long long>& starts,
+                                         const TwinInputs& twin) {
+  const std::vector<std::uint8_t> image = twin.image ? *twin.image : model_image(cfg, what);
+  const std::vector<std::vector<double>>* measured = twin.measured;
   std::vector<link::Telemetry> out(samples.size());
   const auto n = static_cast<long long>(samples.size());
   // One life from each start (the first at 0) to the next: a fresh plant.
@@ -31,10 +33,15 @@ std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std:
     HostPlant plant;
     char msg[64] = {};
     if (!plant.load(image, cfg, msg, sizeof msg)) throw std::runtime_error(what + ": " + msg);
+    const auto sense = [&](std::size_t k) {
+      if (measured) plant.sense((*measured)[k].data(), static_cast<int>((*measured)[k].size()));
+    };
     const auto k0 = static_cast<std::size_t>(from[i]);
+    sense(k0);
     plant.init(samples[k0], 0);
     plant.read(&out[k0]);
     for (auto k = k0 + 1; k < static_cast<std::size_t>(from[i + 1]); ++k) {
+      sense(k);
       plant.step(samples[k], 0);
       plant.read(&out[k]);
     }

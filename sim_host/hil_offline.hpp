@@ -20,7 +20,14 @@ std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::st
 // as the node reads it (HostPlant), so equal code gives equal bits. With
 // `starts` (a restarted node's first samples, ascending), a fresh plant from
 // rest at each, as the restarted node does: the clean run of each node life.
+// A twin estimator's run needs what the node gets beyond the configuration:
+// its twin image and each sample's measured floor accelerations.
+struct TwinInputs {
+  const std::vector<std::uint8_t>* image = nullptr;
+  const std::vector<std::vector<double>>* measured = nullptr;
+};
 std::vector<link::Telemetry> offline_run(const link::NodeConfig& cfg, const std::vector<double>& samples,
-                                         const std::string& what, const std::vector<long long>& starts = {});
+                                         const std::string& what, const std::vector<long long>& starts = {},
+                                         const TwinInputs& twin = {});
 
 }  // namespace vines::host

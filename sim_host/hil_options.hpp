@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "sim_host/twin_design.hpp"
+
 namespace vines::host {
 
 // When a fault is injected: with a probability per sample, or at samples.
@@ -30,6 +32,11 @@ enum class HilMode { kReplay, kTwin, kHybrid };
 inline constexpr const char* kHilModeNames[] = {"replay", "twin", "hybrid"};
 inline const char* hil_mode_name(HilMode m) { return kHilModeNames[static_cast<int>(m)]; }
 
+// The twin node's estimator: none (the open-loop twin: the scene's model on
+// the ground acceleration) or kalman (docs/twin.md); names for --estimator.
+enum class HilEstimator { kNone, kKalman };
+inline constexpr const char* kHilEstimatorNames[] = {"none", "kalman"};
+
 // The hybrid node's compensation of the table's delay: none, polynomial
 // extrapolation, adaptive (ATS); names for --comp and the report.
 enum class HilComp { kNone, kPoly, kAdaptive };
@@ -50,8 +57,15 @@ struct HilOptions {
   // node fault policy
   double grace_periods = 1.5, node_stall_periods = 10;
   // twin
-  double truth_stiffness_scale = 1;  // the bench's building (eta_k)
-  double measure_noise_mps2 = 0;
+  HilEstimator estimator = HilEstimator::kKalman;
+  std::string truth_path;            // the measured building's scene ("" : the node's scene)
+  double truth_stiffness_scale = 1;  // the bench's building (eta_k), times the truth scene's
+  std::vector<int> sensors;          // floor accelerometers, 1-based (empty: the top floor)
+  double measure_noise_mps2 = 0;     // sensor noise, RMS...
+  double measure_noise_pct = 0;      // ...or as % of each channel's RMS
+  double measure_bias_mps2 = 0;      // each sensor's bias drawn from N(0, this^2)
+  double adc_lsb_mps2 = 0;           // ADC resolution (0: none)
+  TwinTuning tuning;
   double drift_limit_m = 0;          // every story (0: no alarm)
   double residual_limit_mps2 = 0.05;
   double residual_window_s = 1.0;

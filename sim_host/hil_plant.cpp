@@ -89,6 +89,18 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
       return refuse("loop.sensor_rate_hz: differs from the hybrid frame image's");
     return true;
   }
+  twin_.reset();
+  if (c.estimator == link::TwinEstimator::kKalman) {
+    if (!twin::is_twin_image(image_.data(), image_.size()))
+      return refuse("estimator kalman: the model image is not a twin image");
+    twin_ = std::make_unique<link::TwinPlant<double, kMaxStories>>();
+    twin_->image_begin();
+    const char* why = twin_->image_push(image_.data(), image_.size());
+    if (!why) why = twin_->image_finish();
+    if (!why) why = twin_->check(c);
+    if (why) twin_.reset();
+    return !why || refuse(why);
+  }
   const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;
   try {
     engine_ = engine_for(c.scene, scalar, "node");
@@ -102,11 +114,13 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
 void HostPlant::init(double a0, double f0) {
   guard_events_ = 0;
   if (mode_ == link::NodeMode::kHybrid) hybrid_.init(a0, f0);
+  else if (twin_) twin_->init(a0);
   else engine_->init(a0);
 }
 
 void HostPlant::step(double a1, double f1) {
   if (mode_ == link::NodeMode::kHybrid) hybrid_.step(a1, f1);
+  else if (twin_) twin_->step(a1);
   else engine_->step(a1);
 }
 
@@ -118,6 +132,7 @@ void HostPlant::read(link::Telemetry* t) {
     t->elastic_energy = hybrid_.elastic_energy();
     return;
   }
+  if (twin_) return twin_->read(t);
   const Snapshot s = engine_->snapshot();
   const Probe p = engine_->probe();
   const int n = n_;

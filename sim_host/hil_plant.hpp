@@ -1,6 +1,8 @@
 // The plant a host node runs (the firmware node's Plant, link/node.hpp): the
-// scene's compiled firmware instance (replay and twin modes), or the bare
-// frame with the table's measured force (hybrid mode), chosen at configure.
+// scene's compiled firmware instance (replay mode, twin without estimator),
+// the twin estimator (twin mode, estimator kalman: link/twin_plant.hpp), or
+// the bare frame with the table's measured force (hybrid mode), chosen at
+// configure.
 #pragma once
 
 #include <cstddef>
@@ -11,6 +13,7 @@
 #include "vines/link/config.hpp"
 #include "vines/link/hybrid_frame.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/link/twin_plant.hpp"
 
 namespace vines::host {
 
@@ -30,6 +33,9 @@ class HostPlant {
   // A whole image then the settings, as a session sends them (offline runs,
   // tests): false with the reason in msg if either is refused.
   bool load(const std::vector<std::uint8_t>& image, const link::NodeConfig& c, char* msg, std::size_t cap);
+  void sense(const double* y, int ny) {
+    if (twin_) twin_->sense(y, ny);
+  }
   void init(double a0, double f0);
   void step(double a1, double f1);
   void read(link::Telemetry* t);
@@ -40,6 +46,7 @@ class HostPlant {
   int n_ = 0;
   std::unique_ptr<Engine> engine_;
   link::HybridFrame<double> hybrid_;
+  std::unique_ptr<link::TwinPlant<double, kMaxStories>> twin_;  // twin estimator (null otherwise)
   long long guard_events_ = 0;  // core guard counters at the last read
 };
 

@@ -23,8 +23,42 @@ json to_json(const std::vector<std::optional<double>>& xs) {
   return a;
 }
 
+json to_json(const HilTwinDevice& d) {
+  json j = {{"kind", d.kind}};
+  if (d.kind == "vines")
+    j.update({{"impulse_estimated_ns", d.impulse_estimated_ns},
+              {"impulse_truth_ns", d.impulse_truth_ns},
+              {"impacts_estimated", d.impacts_estimated},
+              {"contacts_truth", d.contacts_truth},
+              {"added_mass_ratio", d.added_mass_ratio},
+              {"sphere", d.sphere}});
+  if (d.kind == "tmd")
+    j.update({{"frequency_factor", d.frequency_factor},
+              {"frequency_factor_sd", d.frequency_factor_sd},
+              {"truth_frequency_factor", d.truth_frequency_factor},
+              {"detuned", d.detuned}});
+  return j;
+}
+
 json to_json(const HilTwinReport& t) {
-  return {{"truth_stiffness_scale", t.truth_stiffness_scale},
+  json j = {{"estimator", t.estimator},
+            {"truth", t.truth},
+            {"truth_story_scales", t.truth_story_scales},
+            {"sensors", t.sensors},
+            {"noise_sd_mps2", t.noise_sd_mps2},
+            {"strong_motion_start_s", t.strong_motion_start_s}};
+  if (t.estimator != "none")
+    j.update({{"detected", t.detected},
+              {"story", t.story ? json(*t.story) : json(nullptr)},
+              {"size", to_json(t.size)},
+              {"detect_time_s", to_json(t.detect_time_s)},
+              {"detect_delay_s", to_json(t.detect_delay_s)},
+              {"eta_k", t.eta_k},
+              {"eta_k_sd", t.eta_k_sd},
+              {"roof_displacement_nrmse", to_json(t.roof_displacement_nrmse)},
+              {"roof_displacement_sd_m", t.roof_displacement_sd_m},
+              {"device", to_json(t.device)}});
+  j.update({{"truth_stiffness_scale", t.truth_stiffness_scale},
           {"residual_rms_mps2", t.residual_rms_mps2},
           {"residual_max_mps2", t.residual_max_mps2},
           {"residual_limit_mps2", t.residual_limit_mps2},
@@ -33,7 +67,8 @@ json to_json(const HilTwinReport& t) {
           {"drift_limit_m", t.drift_limit_m},
           {"drift_alarm_steps", t.drift_alarm_steps},
           {"first_drift_alarm_s", to_json(t.first_drift_alarm_s)},
-          {"stories_alarmed", t.stories_alarmed}};
+          {"stories_alarmed", t.stories_alarmed}});
+  return j;
 }
 
 json to_json(const std::optional<HilAtsCoefficients>& a) {
@@ -132,7 +167,7 @@ json to_json(const HilReport& r) {
 }
 
 void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h) {
+                   int stories, double h, const CsvColumns& extra) {
   CsvWriter f(path);
   const bool hybrid = !rec.table_x.empty();
   const int n = stories;
@@ -142,6 +177,7 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
                         "dissipated_J", "aux", "drift_alarms"})
     f.raw(c);
   if (hybrid) f.raw("table_x_m").raw("force_measured_n");
+  for (const std::string& c : extra.names) f.raw(c);
   f.end_row();
   constexpr const char* kFull = "%.17g";
   for (long long k = 0; k < rec.samples; ++k) {
@@ -154,6 +190,8 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
     for (double v : {t.acc_top, t.elastic_energy, t.particle_x, t.contact_force, t.dissipated, t.aux}) f.number(v, kFull);
     f.raw(std::to_string(static_cast<unsigned long long>(t.drift_alarms)));
     if (hybrid) f.number(rec.table_x[k], kFull).number(rec.force[k], kFull);
+    if (!extra.names.empty())
+      for (double v : extra.rows[static_cast<std::size_t>(k)]) f.number(v, "%.9g");
     f.end_row();
   }
   f.close();

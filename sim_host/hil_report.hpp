@@ -20,6 +20,13 @@ namespace vines::host {
 
 struct HilRecord;
 
+// A mode's own columns of the per-step CSV: names, and rows[k] the values at
+// sample k.
+struct CsvColumns {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+};
+
 // Mean and quantiles of a set of values.
 struct HilStats {
   double mean = 0, p50 = 0, p99 = 0, max = 0;
@@ -52,8 +59,38 @@ struct HilBoardSteps {
   double median_step_instructions = 0;
 };
 
-// Twin mode: the residual of the twin against the measured building, alarms.
+// Twin mode, the device's health as the estimator sees it (docs/twin.md
+// section 6): a VI NES's impulses, impacts and added mass against the
+// truth's; a TMD's frequency against its design.
+struct HilTwinDevice {
+  std::string kind = "none";
+  // VI NES
+  double impulse_estimated_ns = 0, impulse_truth_ns = 0;
+  long long impacts_estimated = 0, contacts_truth = 0;
+  double added_mass_ratio = 0;   // the force's regression on the floor's acceleration, over the sphere's mass
+  std::string sphere;            // "moving", "stuck" (moves with its floor) or "still" (no impact seen)
+  // TMD
+  double frequency_factor = 1, frequency_factor_sd = 0, truth_frequency_factor = 1;
+  bool detuned = false;
+};
+
+// Twin mode: with the estimator, what it says of the building against the
+// truth; and, as for the open-loop twin, the residual of the top floor
+// against its measurement, alarms.
 struct HilTwinReport {
+  std::string estimator = "kalman";
+  std::string truth;                       // the truth's scene ("" : the node's own)
+  std::vector<double> truth_story_scales;  // each story's stiffness factor in the truth
+  std::vector<int> sensors;
+  std::vector<double> noise_sd_mps2;
+  bool detected = false;
+  std::optional<int> story;                // 1-based
+  std::optional<double> size, detect_time_s, detect_delay_s;
+  double strong_motion_start_s = 0;
+  std::vector<double> eta_k, eta_k_sd;     // at the end, per story
+  std::optional<double> roof_displacement_nrmse;  // RMS error over the truth's RMS
+  double roof_displacement_sd_m = 0;       // the design's steady-state sd
+  HilTwinDevice device;
   double truth_stiffness_scale = 1;
   double residual_rms_mps2 = 0, residual_max_mps2 = 0, residual_limit_mps2 = 0;
   long long residual_alarm_steps = 0;
@@ -135,6 +172,6 @@ nlohmann::json to_json(const HilReport& r);
 // Writes --csv: one row per sample (hybrid: with the table and the load cell).
 // Throws naming the file if it cannot be written.
 void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h);
+                   int stories, double h, const CsvColumns& extra = {});
 
 }  // namespace vines::host

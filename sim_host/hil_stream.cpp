@@ -73,6 +73,7 @@ class Stream {
     s.ag = rec_.sensed[k];
     s.aux = mode_.aux(k, rec_);
     s.table_x = mode_.table_x(k, rec_);
+    s.ny = static_cast<std::uint8_t>(mode_.floors(k, s.y));
     const FaultEvent* e = at_[static_cast<std::size_t>(k)];
     if (e && e->kind == FaultKind::kNonFinite) s.ag = k % 2 ? std::numeric_limits<double>::infinity() : std::nan("");
     return node_->encode(link::MsgType::kSample, s);

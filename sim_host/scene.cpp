@@ -7,7 +7,8 @@
 //                 equal-length arrays, bottom story first, 1..40 entries
 //             damping = "stiffness" | "rayleigh" | "modal"   (default stiffness)
 //             stiffness_damping_s, rayleigh_zeta = [z1, z2],
-//             rayleigh_modes = [m1, m2], modal_zeta, stiffness_scale (eta_k)
+//             rayleigh_modes = [m1, m2], modal_zeta, stiffness_scale (eta_k),
+//             stiffness_scales = [per story, bottom first]
 //   [device]  kind = "none" | "tmd" | "vines"  (required when [device] is given;
 //                 no [device] table means no device)
 //             floor (1-based, default top), mass_ratio | mass_kg (not both)
@@ -120,6 +121,13 @@ void read_frame(const Section& s, FrameParams* f) {
   s.read_fixed("rayleigh_modes", f->rayleigh_modes);
   s.read("modal_zeta", &f->modal_zeta);
   s.read("stiffness_scale", &f->stiffness_scale);
+  // Per-story damage: one factor a story, bottom first.
+  std::vector<double> scales;
+  if (s.read("stiffness_scales", &scales)) {
+    if (scales.size() != static_cast<std::size_t>(f->stories))
+      s.fail_at("stiffness_scales", "must have one factor per story (" + std::to_string(f->stories) + ")");
+    std::copy(scales.begin(), scales.end(), f->stiffness_scales);
+  }
 }
 
 // ---- [device] ----
@@ -275,7 +283,8 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
   read_frame(
       Section(origin, root, "frame",
               {"preset", "masses_kg", "stiffnesses_n_per_m", "damping", "stiffness_damping_s",
-               "rayleigh_zeta", "rayleigh_modes", "modal_zeta", "stiffness_scale"}),
+               "rayleigh_zeta", "rayleigh_modes", "modal_zeta", "stiffness_scale",
+               "stiffness_scales"}),
       &p.frame);
   const Section device(origin, root, "device", {"kind", "floor", "mass_ratio", "mass_kg"});
   read_device(device, &p.device);

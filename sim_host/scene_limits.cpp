@@ -29,9 +29,7 @@ std::optional<LimitError> check_contact_scales(const SceneParams& p) {
   if (p.device.kind != DeviceKind::kVines || p.device.vines.law == ContactLaw::kRestitution) return std::nullopt;
   // The particle as the model designs it: its mass from the nominal frame's
   // first mode (as build_model), the Hertz prefactor C of the pair.
-  FrameParams nominal = p.frame;
-  nominal.stiffness_scale = 1.0;
-  const double m_eff1 = reference::host_modes(reference::build_host_frame(nominal)).m_eff[0];
+  const double m_eff1 = reference::host_modes(reference::build_host_frame(undamaged(p.frame))).m_eff[0];
   const double mass = p.device.mass_kg > 0.0 ? p.device.mass_kg : p.device.mass_ratio * m_eff1;
   VinesParams hertz = p.device.vines;
   hertz.law = ContactLaw::kHertz;  // C, radius and mass only: no Kuwabara calibration

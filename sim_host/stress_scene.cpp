@@ -79,7 +79,7 @@ struct FirstMode {
 FirstMode first_mode(const FrameParams& f) {
   const int n = f.stories;
   std::vector<double> x(n, 1.0), k(n + 1, 0.0), cp(n), dp(n);
-  for (int i = 0; i < n; ++i) k[i] = f.stiffness_n_per_m[i] * f.stiffness_scale;
+  for (int i = 0; i < n; ++i) k[i] = story_stiffness(f, i);
   for (int it = 0; it < 100; ++it) {
     // Solve K y = M x (Thomas): diagonal k_i + k_{i+1}, off-diagonals -k_{i+1}.
     for (int i = 0; i < n; ++i) {

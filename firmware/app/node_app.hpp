@@ -41,6 +41,7 @@ class TimedPlant {
     return true;
   }
 
+  void sense(const double* y, int ny) { p_->sense(y, ny); }
   void init(double a0, double f0) {
     monitor_ = hal::DeadlineMonitor(budget_);
     worst_k_ = 0;

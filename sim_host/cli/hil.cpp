@@ -31,6 +31,37 @@ struct HilArgs {
   bool accept_degraded = false;
 };
 
+// The twin's part of the report as text.
+void print_twin(const host::HilTwinReport& t) {
+  std::printf("  twin (%s estimator), truth %s, sensors on floors", t.estimator.c_str(),
+              t.truth.empty() ? "the scene itself" : t.truth.c_str());
+  for (int s : t.sensors) std::printf(" %d", s);
+  std::printf("\n    residual RMS %.4g m/s^2 (max %.4g), residual alarm %lld steps", t.residual_rms_mps2,
+              t.residual_max_mps2, t.residual_alarm_steps);
+  if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
+  std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
+  if (t.estimator == "none") return;
+  if (t.detected && t.story && t.size)
+    std::printf("    DAMAGE: story %d, loss %.1f %% at %.2f s (%.2f s after strong motion starts at %.2f s)\n", *t.story,
+                100 * *t.size, *t.detect_time_s, *t.detect_delay_s, t.strong_motion_start_s);
+  else
+    std::printf("    no damage detected\n");
+  std::printf("    eta_k (sd) by story:");
+  for (std::size_t i = 0; i < t.eta_k.size(); ++i) std::printf(" %.3f (%.3f)", t.eta_k[i], t.eta_k_sd[i]);
+  std::printf("\n    roof displacement NRMSE %s (steady-state sd %.3g mm)\n",
+              t.roof_displacement_nrmse ? format("%.4f", *t.roof_displacement_nrmse).c_str() : "n/a",
+              1e3 * t.roof_displacement_sd_m);
+  const host::HilTwinDevice& d = t.device;
+  if (d.kind == "vines")
+    std::printf("    VI NES: sphere %s; impulse |F| dt %.4g N s (truth %.4g), %lld impacts seen (truth %lld contacts), "
+                "added mass %.2f x the sphere's\n",
+                d.sphere.c_str(), d.impulse_estimated_ns, d.impulse_truth_ns, d.impacts_estimated, d.contacts_truth,
+                d.added_mass_ratio);
+  if (d.kind == "tmd")
+    std::printf("    TMD: frequency %.3f (sd %.3f) x its design (truth %.3f)%s\n", d.frequency_factor,
+                d.frequency_factor_sd, d.truth_frequency_factor, d.detuned ? ": DETUNED" : "");
+}
+
 // The hil report as text.
 void print_hil(const host::HilReport& r) {
   std::printf("hil %s: %s mode, %s clock, %s, %.0f Hz, node %s\n", r.scene.c_str(), host::hil_mode_name(r.mode),
@@ -65,13 +96,7 @@ void print_hil(const host::HilReport& r) {
   std::printf("  max deviation from offline %.3g m%s; outputs finite: %s\n", r.max_deviation_from_offline,
               r.bit_exact ? " (bit for bit equal)" : "", r.outputs_finite ? "yes" : "NO");
   // The modes
-  if (r.twin) {
-    const host::HilTwinReport& t = *r.twin;
-    std::printf("  twin: eta_k %.3g, residual RMS %.4g m/s^2 (max %.4g), residual alarm %lld steps",
-                t.truth_stiffness_scale, t.residual_rms_mps2, t.residual_max_mps2, t.residual_alarm_steps);
-    if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
-    std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
-  }
+  if (r.twin) print_twin(*r.twin);
   if (r.hybrid) {
     const host::HilHybridReport& hy = *r.hybrid;
     // The compensation, then the tracking and the top floor against the pure simulation.
@@ -257,12 +282,49 @@ void add_hil(CLI::App& vines) {
       ->group(faults);
 
   const std::string twin = "twin options";
-  cmd->add_option("--truth-stiffness-scale", opt.truth_stiffness_scale, "the measured building's eta_k (default 1)")
+  const std::vector<std::string> estimators(std::begin(host::kHilEstimatorNames), std::end(host::kHilEstimatorNames));
+  cmd->add_option_function<std::string>(
+         "--estimator",
+         [&opt, estimators](const std::string& v) {
+           opt.estimator =
+               static_cast<host::HilEstimator>(std::find(estimators.begin(), estimators.end(), v) - estimators.begin());
+         },
+         "kalman (default: the node keeps the frame's state on the measured floors, identifies each story's "
+         "stiffness and decides on damage, docs/twin.md) or none (the scene's model run open loop)")
+      ->type_name("kalman|none")
+      ->check(CLI::IsMember(estimators))
+      ->group(twin);
+  cmd->add_option("--truth", opt.truth_path,
+                  "the measured building's scene (default: SCENE itself): same story count, sensor rate and record; "
+                  "its own frame (frame.stiffness_scales for a damaged story), device and initial state")
+      ->type_name("TRUTH.toml")
+      ->check(non_empty_path())
+      ->group(twin);
+  cmd->add_option("--truth-stiffness-scale", opt.truth_stiffness_scale,
+                  "the measured building's eta_k, times the truth scene's (default 1)")
       ->type_name("ETA")
       ->check(number_in(0.01, 10))
       ->group(twin);
-  cmd->add_option("--measure-noise", opt.measure_noise_mps2, "measurement noise (m/s^2 RMS, default 0)")
+  add_number_list(*cmd, "--sensors", &opt.sensors, 0, 1000,
+                  "floor accelerometers, 1-based, comma-separated (default: the top floor; at most 8); the ground "
+                  "accelerometer is the node's input")
+      ->type_name("F1,F2,...")
+      ->group(twin);
+  cmd->add_option("--measure-noise", opt.measure_noise_mps2, "sensor noise (m/s^2 RMS, default 0)")
       ->type_name("A")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--measure-noise-pct", opt.measure_noise_pct, "sensor noise as % of each channel's RMS")
+      ->type_name("P")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--measure-bias", opt.measure_bias_mps2,
+                  "each sensor's constant bias, drawn from N(0, B^2) (m/s^2, default 0)")
+      ->type_name("B")
+      ->check(number_in(0, 1e3))
+      ->group(twin);
+  cmd->add_option("--adc-lsb", opt.adc_lsb_mps2, "ADC resolution: readings rounded to it (m/s^2, default 0: none)")
+      ->type_name("Q")
       ->check(number_in(0, 1e3))
       ->group(twin);
   cmd->add_option("--drift-limit", opt.drift_limit_m, "drift alarm, every story (m; default 0: none)")
@@ -277,6 +339,24 @@ void add_hil(CLI::App& vines) {
       ->type_name("S")
       ->check(number_in(1e-6, 1e6))
       ->group(twin);
+
+  // The estimator's tuning (docs/twin.md section 4): defaults from there.
+  const std::string tuning = "twin estimator tuning (docs/twin.md section 4)";
+  host::TwinTuning& tu = opt.tuning;
+  const std::pair<const char*, std::pair<double*, const char*>> knobs[] = {
+      {"--twin-model-sd", {&tu.model_accel_sd, "process noise: floor acceleration the model misses [m/s^2]"}},
+      {"--twin-force-sd", {&tu.force_sd_mps2, "VI NES force over its floor's mass, sd [m/s^2]"}},
+      {"--twin-force-tau", {&tu.force_tau_s, "its correlation time [s]"}},
+      {"--twin-memory", {&tu.memory_s, "the losses' memory [s]"}},
+      {"--twin-prior-sd", {&tu.prior_sd, "prior sd of each loss"}},
+      {"--twin-max-step", {&tu.max_step, "largest change of a loss in one update"}},
+      {"--twin-kappa", {&tu.kappa, "alarm: loss beyond this many sd..."}},
+      {"--twin-loss-min", {&tu.loss_min, "...and beyond this loss (stories)"}},
+      {"--twin-device-loss-min", {&tu.device_loss_min, "the TMD spring's |loss| for its alarm"}},
+      {"--twin-hold", {&tu.hold_s, "held this long [s]"}},
+  };
+  for (const auto& [name, k] : knobs)
+    cmd->add_option(name, *k.first, k.second)->type_name("X")->check(number_in(1e-9, 1e6))->group(tuning);
 
   const std::string hybrid = "hybrid options";
   cmd->add_option("--actuator-hz", opt.actuator_hz, "natural frequency of the actuator, a second-order servo (Hz, default 20)")

@@ -47,7 +47,7 @@ HostFrame build_host_frame(const FrameParams& p) {
   f.n = n;
   for (int i = 0; i < n; ++i) {
     f.m.push_back(p.mass_kg[i]);
-    f.k.push_back(p.stiffness_n_per_m[i] * p.stiffness_scale);
+    f.k.push_back(story_stiffness(p, i));
   }
   // Tridiagonal shear matrix: story i links floor i-1 and floor i.
   f.K.assign(static_cast<std::size_t>(n * n), 0.0);

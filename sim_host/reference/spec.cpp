@@ -28,9 +28,7 @@ OdeSpec make_spec(const SceneParams& p) {
   if (s.kind == DeviceKind::kNone) return s;
 
   // Devices are designed on the nominal (undamaged) frame, as in build_model.
-  FrameParams nominal = p.frame;
-  nominal.stiffness_scale = 1.0;
-  const HostModes nm = host_modes(build_host_frame(nominal));
+  const HostModes nm = host_modes(build_host_frame(undamaged(p.frame)));
   const double mass = p.device.mass_kg > 0.0 ? p.device.mass_kg : p.device.mass_ratio * nm.m_eff[0];
   const double floor_mass = s.frame.m[static_cast<std::size_t>(s.floor)];
   if (s.kind == DeviceKind::kTmd) {

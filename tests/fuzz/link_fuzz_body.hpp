@@ -35,6 +35,7 @@ struct ToyPlant {
     n = c.scene.frame.stories;
     return true;
   }
+  void sense(const double*, int) {}
   void init(double a0, double f0) { a = a0, f = f0; }
   void step(double a1, double f1) { a = a1, f = f1; }
   void read(Telemetry* t) const {

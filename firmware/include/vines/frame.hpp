@@ -69,7 +69,7 @@ Frame<N> build_frame(const FrameParams& p) {
   Frame<N> f;
   for (int i = 0; i < N; ++i) {
     f.m(i) = p.mass_kg[i];
-    f.k(i) = p.stiffness_n_per_m[i] * p.stiffness_scale;
+    f.k(i) = story_stiffness(p, i);
   }
   f.K = shear_matrix<N>(f.k);
   f.C.setZero();

@@ -237,9 +237,7 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   // Frame as simulated (damage applied) and nominal (devices are designed on it).
   md.frame = build_frame<N>(p.frame);
   md.modal = modal_analysis(md.frame);
-  FrameParams nominal = p.frame;
-  nominal.stiffness_scale = 1.0;
-  md.nominal_modal = modal_analysis(build_frame<N>(nominal));
+  md.nominal_modal = modal_analysis(build_frame<N>(undamaged(p.frame)));
   md.loop = p.loop;
   md.h = 1.0 / p.loop.sensor_rate_hz;
   md.hs = static_cast<S>(md.h);

@@ -29,10 +29,26 @@ struct FrameParams {
   double rayleigh_zeta[2] = {0.02, 0.02};  // kRayleigh: target ratios...
   int rayleigh_modes[2] = {1, 2};          // ...on these modes (1-based)
   double modal_zeta = 0.02;                // kModal
-  // Damage: every story stiffness is scaled by eta_k. Damping is built from the
-  // scaled K (C = c_k K stays proportional to what the frame really has).
+  // Damage: every story stiffness is scaled by eta_k, and story i also by
+  // stiffness_scales[i] (bottom first). Damping is built from the scaled K
+  // (C = c_k K stays proportional to what the frame really has).
   double stiffness_scale = 1.0;
+  double stiffness_scales[kMaxStories] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
+                                          1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
 };
+static_assert(kMaxStories == 40, "stiffness_scales' initialiser lists kMaxStories ones");
+
+// Story i's stiffness as built: nominal, times eta_k, times its own factor.
+inline double story_stiffness(const FrameParams& f, int i) {
+  return f.stiffness_n_per_m[i] * f.stiffness_scale * f.stiffness_scales[i];
+}
+
+// The frame undamaged: what devices are designed on.
+inline FrameParams undamaged(FrameParams f) {
+  f.stiffness_scale = 1.0;
+  for (double& s : f.stiffness_scales) s = 1.0;
+  return f;
+}
 
 enum class DeviceKind : std::uint8_t { kNone, kTmd, kVines };
 

@@ -22,6 +22,9 @@ inline ParamError validate(const FrameParams& f) {
   }
   if (!finite_positive(f.stiffness_scale) || f.stiffness_scale > 10.0)
     return {"frame.stiffness_scale", "must be in (0, 10]"};
+  for (int i = 0; i < f.stories; ++i)
+    if (!finite_positive(f.stiffness_scales[i]) || f.stiffness_scales[i] > 10.0)
+      return {"frame.stiffness_scales", "must be in (0, 10]", i};
   switch (f.damping) {
     case DampingRule::kStiffnessProportional:
       if (!std::isfinite(f.stiffness_damping_s) || f.stiffness_damping_s < 0.0)

@@ -15,6 +15,11 @@
 
 namespace vines::link {
 
+// A twin node's estimator: none (the scene's model run open loop on the
+// ground acceleration) or the Kalman filter with stiffness identification of
+// twin/estimator.hpp (docs/twin.md).
+enum class TwinEstimator : std::uint8_t { kNone, kKalman };
+
 enum class NodeMode : std::uint8_t {
   kReplay,  // ground acceleration in, the scene's model out (bench mode)
   kTwin,    // digital twin: also measured top-floor acceleration in; residual and alarms out
@@ -36,6 +41,7 @@ struct NodeConfig {
   double grace_periods = 1.5;    // a sample is due at k h; missing after k h + grace h: held
   double stall_periods = 10;     // no frame for this long: a stall is reported
   // Twin:
+  TwinEstimator estimator = TwinEstimator::kNone;  // kKalman: the model image is a twin image
   double drift_limit_m[kMaxStories] = {};  // per story (0: no alarm)
   double residual_limit_mps2 = 0;          // RMS residual alarm threshold (0: none)
   double residual_window_s = 1.0;          // time constant of the running RMS
@@ -49,7 +55,7 @@ struct NodeConfig {
   std::uint32_t budget_ticks = 0;
 };
 
-inline constexpr std::size_t kMaxConfigBlob = 1600;
+inline constexpr std::size_t kMaxConfigBlob = 1800;
 
 inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap) {
   Writer w(b, cap);
@@ -59,6 +65,7 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
   w.u8(static_cast<std::uint8_t>(n));
   for (int i = 0; i < n; ++i) w.f64(f.mass_kg[i]);
   for (int i = 0; i < n; ++i) w.f64(f.stiffness_n_per_m[i]);
+  for (int i = 0; i < n; ++i) w.f64(f.stiffness_scales[i]);
   w.u8(static_cast<std::uint8_t>(f.damping));
   for (double v : {f.stiffness_damping_s, f.rayleigh_zeta[0], f.rayleigh_zeta[1], f.modal_zeta, f.stiffness_scale})
     w.f64(v);
@@ -92,6 +99,7 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
   w.u32(c.budget_ticks);
   w.u8(static_cast<std::uint8_t>(c.comp_kind));
   w.f64(c.comp_window_s);
+  w.u8(static_cast<std::uint8_t>(c.estimator));
   return w.ok() ? w.size() : 0;
 }
 
@@ -105,6 +113,7 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
   f.stories = n;
   for (int i = 0; i < n; ++i) f.mass_kg[i] = r.f64();
   for (int i = 0; i < n; ++i) f.stiffness_n_per_m[i] = r.f64();
+  for (int i = 0; i < n; ++i) f.stiffness_scales[i] = r.f64();
   const std::uint8_t damping = r.u8();
   if (damping > static_cast<std::uint8_t>(DampingRule::kModal)) return false;
   f.damping = static_cast<DampingRule>(damping);
@@ -156,6 +165,9 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
   c->budget_ticks = r.u32();
   c->comp_kind = static_cast<CompKind>(r.u8());
   c->comp_window_s = r.f64();
+  const std::uint8_t est = r.u8();
+  if (est > static_cast<std::uint8_t>(TwinEstimator::kKalman)) return false;
+  c->estimator = static_cast<TwinEstimator>(est);
   return r.done();
 }
 
@@ -171,6 +183,7 @@ inline const char* validate_node(const NodeConfig& c) {
   for (int i = 0; i < c.scene.frame.stories; ++i)
     if (!nonneg(c.drift_limit_m[i])) return "drift_limit: must be finite and >= 0";
   if (!nonneg(c.residual_limit_mps2)) return "residual_limit: must be finite and >= 0";
+  if (c.estimator != TwinEstimator::kNone && c.mode != NodeMode::kTwin) return "estimator: only in twin mode";
   if (!(c.residual_window_s > 0.0 && std::isfinite(c.residual_window_s))) return "residual_window: must be > 0";
   if (!(c.comp_delay_s >= 0.0 && c.comp_delay_s <= 1.0)) return "comp_delay: must be 0 to 1 s";
   if (c.comp_order < 1 || c.comp_order > 3) return "comp_order: must be 1, 2 or 3";

@@ -11,6 +11,7 @@
 
 #include "vines/link/wire.hpp"
 #include "vines/params.hpp"
+#include "vines/twin/image.hpp"
 
 namespace vines::link {
 
@@ -41,6 +42,8 @@ struct Sample {
   double ag = 0;           // ground acceleration [m/s^2]
   double aux = 0;          // twin: measured top-floor acceleration (NaN: none); hybrid: measured force [N]
   double table_x = 0;      // hybrid: measured table displacement [m] (NaN: none); other modes: 0, unused
+  std::uint8_t ny = 0;     // twin with an estimator: floor accelerations measured (0: none)...
+  double y[twin::kMaxSensors] = {};  // ...at the twin image's sensors, in its order [m/s^2]
 };
 
 // node -> bench ------------------------------------------------------------
@@ -55,6 +58,8 @@ enum StepFlag : std::uint16_t {
   kResidualAlarm = 1u << 5, // top-floor acceleration residual beyond its limit (twin)
   kAuxMissing = 1u << 6,    // measured value missing or non-finite: last one used
   kGuard = 1u << 7,         // the core's guards acted (sample held or step rolled back)
+  kDamage = 1u << 8,        // twin estimator: damage detected (latched), story in alarm_story
+  kDeviceAlarm = 1u << 9,   // twin estimator: the TMD's spring off its design (detuned)
 };
 
 struct Telemetry {
@@ -73,6 +78,11 @@ struct Telemetry {
   std::uint64_t drift_alarms = 0;  // bit i: story i+1 beyond its limit
   std::uint32_t step_ticks = 0;    // the model's work for this step, in the node's counter ticks
   double comp[3] = {};             // hybrid, adaptive: the compensator's a0, a1 [s], a2 [s^2]; else 0
+  // Twin estimator: one spring's stiffness factor and its sd per step, in
+  // turn (est_index: 0..stories-1 the stories, stories the TMD's spring),
+  // and the story in alarm (1-based, 0: none).
+  std::uint8_t est_index = 0, alarm_story = 0;
+  double est_eta = 0, est_sd = 0;
 };
 
 // The node's deadline monitor: every step's model work timed on the node's
@@ -156,6 +166,9 @@ void layout(IO& io, M& s, Sample*) {
   io.field(s.ag);
   io.field(s.aux);
   io.field(s.table_x);
+  io.field(s.ny);
+  if (s.ny > twin::kMaxSensors) io.fail();
+  for (int i = 0; i < s.ny && i < twin::kMaxSensors; ++i) io.field(s.y[i]);
 }
 
 template <class IO, class M>
@@ -177,6 +190,10 @@ void layout(IO& io, M& t, Telemetry*) {
   io.field(t.drift_alarms);
   io.field(t.step_ticks);
   for (auto& c : t.comp) io.field(c);
+  io.field(t.est_index);
+  io.field(t.alarm_story);
+  io.field(t.est_eta);
+  io.field(t.est_sd);
 }
 
 template <class IO, class M>

@@ -9,6 +9,8 @@
 //     or why it is refused: corrupt, truncated, built for another node);
 //   bool configure(const NodeConfig&, char* msg, size_t cap): the settings,
 //     checked against the model image (false with the reason in msg);
+//   void sense(const double* y, int ny): the step's measured floor
+//     accelerations (twin estimator; nullptr, 0: none), before init or step;
 //   void init(double a0, double f0); void step(double a1, double f1);
 //   void read(Telemetry*) (fills n, x, acc_top, energies, particle,
 //     step_ticks; flags kGuard when the core's guards acted in the last step);
@@ -274,9 +276,13 @@ class Node {
       aux = aux_last_;
       flags |= kAuxMissing;
     }
+    // The measured floors: all finite, or the step has none.
+    const double* y = s.ny > 0 ? s.y : nullptr;
+    for (int i = 0; y && i < s.ny; ++i)
+      if (!std::isfinite(s.y[i])) y = nullptr, flags |= kAuxMissing;
     if (!initialised_) {
       status_.next_k = s.k;
-      return apply(a, aux, s.table_x, flags, true);
+      return apply(a, aux, s.table_x, flags, true, y, y ? s.ny : 0);
     }
     // Samples missing before this one: interpolated towards it (the table
     // not measured there).
@@ -284,16 +290,18 @@ class Node {
     const double a0 = a_last_;
     for (std::uint32_t i = 1; i <= gap; ++i)
       apply(a0 + (a - a0) * i / (gap + 1.0), aux_last_, kNan, kInterpolated | kAuxMissing, false);
-    apply(a, aux, s.table_x, flags, true);
+    apply(a, aux, s.table_x, flags, true, y, y ? s.ny : 0);
   }
 
   // ---- stepping ---------------------------------------------------------
   // One step on ground acceleration a, the measured value aux (twin:
-  // acceleration, hybrid: force) and, hybrid, the measured table
-  // displacement xm (NaN: not measured).
-  void apply(double a, double aux, double xm, std::uint16_t flags, bool real) {
+  // acceleration, hybrid: force), hybrid, the measured table displacement xm
+  // (NaN: not measured) and, twin, the measured floors y (nullptr: none).
+  void apply(double a, double aux, double xm, std::uint16_t flags, bool real, const double* y = nullptr,
+             int ny = 0) {
     const std::uint32_t k = status_.next_k;
     const double f = cfg_.mode == NodeMode::kHybrid ? aux : 0.0;
+    plant_->sense(y, ny);
     if (!initialised_) {
       plant_->init(a, f);
       initialised_ = true;

@@ -54,6 +54,8 @@ class Writer {
   }
   // A byte both sides know (a table's length): the reader refuses another.
   void constant(std::uint8_t v) { u8(v); }
+  // A value out of its range found by the layout itself.
+  void fail() { overflow_ = true; }
   // A NUL-terminated text shorter than its buffer: length byte, characters.
   template <std::size_t L>
   void text(const char (&s)[L]) {
@@ -129,6 +131,7 @@ class Reader {
   void constant(std::uint8_t v) {
     if (u8() != v) error_ = true;
   }
+  void fail() { error_ = true; }
   template <std::size_t L>
   void text(char (&s)[L]) {
     const std::uint8_t len = u8();

@@ -1,7 +1,8 @@
-// Matrix exponential of a fixed-size square matrix: Pade(13) with scaling and
-// squaring (Higham 2005, the algorithm behind MATLAB's expm). Used only when a
-// model is built, to discretise the linear part exactly; no heap, any scalar
-// with std::ldexp/ceil/log2 (double, long double).
+// Matrix exponential of a square matrix: Pade(13) with scaling and squaring
+// (Higham 2005, the algorithm behind MATLAB's expm). Used only when a model is
+// built, to discretise the linear part exactly; no heap with a fixed-size
+// matrix (the firmware's only use; the host's twin design passes dynamic
+// ones), any scalar with std::ldexp/ceil/log2 (double, long double).
 #pragma once
 
 #include <cmath>
@@ -15,7 +16,6 @@ template <typename Mat>
 Mat expm(const Mat& a) {
   using T = typename Mat::Scalar;
   static_assert(Mat::RowsAtCompileTime == Mat::ColsAtCompileTime, "square matrix");
-  static_assert(Mat::RowsAtCompileTime > 0, "fixed-size matrix");
   // Pade(13) coefficients and the 1-norm bound below which it is accurate.
   constexpr T b[14] = {T(64764752532480000.0), T(32382376266240000.0), T(7771770303897600.0),
                        T(1187353796428800.0),  T(129060195264000.0),   T(10559470521600.0),
@@ -30,7 +30,7 @@ Mat expm(const Mat& a) {
   if (norm1 > kTheta13) s = static_cast<int>(std::ceil(std::log2(norm1 / kTheta13)));
   const Mat as = a * std::ldexp(T(1), -s);
 
-  const Mat ident = Mat::Identity();
+  const Mat ident = Mat::Identity(a.rows(), a.cols());
   const Mat a2 = as * as, a4 = a2 * a2, a6 = a4 * a2;
   const Mat u_inner = a6 * (b[13] * a6 + b[11] * a4 + b[9] * a2) + b[7] * a6 + b[5] * a4 +
                       b[3] * a2 + b[1] * ident;

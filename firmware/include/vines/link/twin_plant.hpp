@@ -1,0 +1,66 @@
+// The plant of a twin node with an estimator (link/node.hpp's Plant, twin
+// mode, estimator kalman): the estimator of twin/estimator.hpp on the twin
+// image the bench designed, its outputs as telemetry. The board's plant
+// (model_plant.hpp) and the host's (sim_host/hil_plant.cpp) both hold one,
+// so the same code runs on either.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "vines/link/config.hpp"
+#include "vines/link/messages.hpp"
+#include "vines/twin/estimator.hpp"
+
+namespace vines::link {
+
+template <typename S, int N>
+class TwinPlant {
+ public:
+  void image_begin() { est_.image_begin(); }
+  const char* image_push(const std::uint8_t* p, std::size_t n) { return est_.image_push(p, n); }
+  const char* image_finish() { return est_.image_finish(); }
+
+  // The settings must fit the twin image held: nullptr, or why not.
+  const char* check(const NodeConfig& c) const {
+    if (!est_.ready()) return "estimator kalman: send a twin image before the settings";
+    if (c.scene.frame.stories != est_.dims().stories) return "frame.stories: differs from the twin image's";
+    if (!(std::fabs(est_.period() * c.scene.loop.sensor_rate_hz - 1.0) <= 1e-12))
+      return "loop.sensor_rate_hz: differs from the twin image's";
+    return nullptr;
+  }
+
+  void sense(const double* y, int ny) { y_ = y, ny_ = ny; }
+  void init(double a0) {
+    est_.init(static_cast<S>(a0), y_, ny_);
+    turn_ = 0;
+  }
+  void step(double a1) { est_.step(static_cast<S>(a1), y_, ny_); }
+
+  // The estimated floors, top-floor acceleration and device force (on its
+  // floor, N); one spring's factor and sd in turn; the alarms.
+  void read(Telemetry* t) {
+    const int n = est_.dims().stories, np = est_.dims().np;
+    t->n = static_cast<std::uint8_t>(n);
+    for (int i = 0; i < n; ++i) t->x[i] = static_cast<double>(est_.x(i));
+    t->acc_top = static_cast<double>(est_.acc_top());
+    t->contact_force = static_cast<double>(est_.force());
+    const int j = turn_;
+    turn_ = turn_ + 1 < np ? turn_ + 1 : 0;
+    t->est_index = static_cast<std::uint8_t>(j);
+    t->est_eta = 1.0 - static_cast<double>(est_.loss(j));
+    t->est_sd = static_cast<double>(est_.loss_sd(j));
+    t->alarm_story = static_cast<std::uint8_t>(est_.alarm_story());
+    if (est_.detected()) t->flags |= kDamage;
+    if (est_.device_alarm()) t->flags |= kDeviceAlarm;
+  }
+
+ private:
+  twin::Estimator<S, N> est_;
+  const double* y_ = nullptr;
+  int ny_ = 0;
+  int turn_ = 0;
+};
+
+}  // namespace vines::link

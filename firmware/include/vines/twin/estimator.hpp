@@ -1,0 +1,402 @@
+// The twin node's estimator (docs/twin.md): a Kalman filter that keeps the
+// frame's state on the measured floor accelerations, with the device's force
+// as an unknown input (VI NES) or the TMD as two more states, and a recursive
+// prediction-error identification of each spring's stiffness loss (stories,
+// and the TMD's spring), with its uncertainty and a damage decision.
+//
+// Everything the node needs is designed on the host and streamed in as the
+// twin image (twin/image.hpp): the steady-state gain, the discrete model, the
+// damage patterns. Per step the node does matrix-vector products only: no
+// covariance recursion for the state (the gain is fixed), one for the losses
+// in information form (a sum of outer products, positive semi-definite by
+// construction) solved by Cholesky every few steps. Fixed capacity for N
+// stories, no heap; S is double or float (transitions stored less identity,
+// so float keeps their small part).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "vines/twin/image.hpp"
+
+namespace vines::twin {
+
+template <typename S, int N>
+class Estimator {
+ public:
+  static constexpr int kQ = N + 1, kX = 2 * N + 2, kP = N + 1, kY = kMaxSensors;
+
+  // ---- the image, streamed -------------------------------------------------
+  void image_begin() {
+    pos_ = 0;
+    value_ = 0;
+    nbyte_ = 0;
+    ready_ = false;
+    failed_ = nullptr;
+  }
+  const char* image_push(const std::uint8_t* p, std::size_t n) {
+    for (std::size_t i = 0; i < n && !failed_; ++i) byte(p[i]);
+    return failed_;
+  }
+  const char* image_finish() {
+    if (failed_) return failed_;
+    if (pos_ < 4 + 2 + 7 || value_ != twin_values(d_) || nbyte_ != 0) return "twin image: truncated";
+    if (const char* why = check()) return why;
+    ready_ = true;
+    return nullptr;
+  }
+  bool ready() const { return ready_; }
+  const TwinDims& dims() const { return d_; }
+  double period() const { return set_[kPeriod]; }
+  int sensor_floor(int i) const { return sensor_[i] + 1; }
+
+  // ---- the loop ------------------------------------------------------------
+  // At rest at sample 0 (y: ny floor accelerations, or nullptr: none).
+  void init(S a0, const double* y, int ny) {
+    for (int i = 0; i < kX; ++i) z_[i] = S(0);
+    for (int j = 0; j < kP; ++j) {
+      loss_[j] = S(0), g_[j] = S(0), sd_[j] = S(0), held_[j] = 0;
+      for (int i = 0; i < kX; ++i) s_[j][i] = S(0);
+      for (int i = 0; i < kP; ++i) J_[j][i] = S(0);
+    }
+    for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
+    k_ = 0;
+    since_ = 0;
+    story_ = -1;
+    detected_ = false;
+    device_alarm_ = false;
+    a_ = a0;
+    update(y, ny);
+    refresh_sd();
+  }
+
+  // One sensor period to ground acceleration a1, then the measurements y.
+  void step(S a1, const double* y, int ny) {
+    predict(a1);
+    update(y, ny);
+    ++k_;
+    if (++since_ >= update_steps_) {
+      since_ = 0;
+      solve();
+      decide();
+    }
+  }
+
+  // ---- outputs -------------------------------------------------------------
+  S x(int floor) const { return z_[floor]; }                // relative displacement [m], 0-based
+  S force() const { return d_.extra == TwinExtra::kForce ? z_[2 * d_.nq] * S(set_[kForceScale]) : S(0); }
+  S acc_top() const {                                        // absolute top-floor acceleration
+    S a = dot(top_c_, z_, d_.nx);
+    for (int j = 0; j < d_.np; ++j) a += top_h_[j] * loss_[j] * w(j, z_);
+    return a;
+  }
+  S loss(int j) const { return loss_[j]; }                   // 1 - eta_j
+  S loss_sd(int j) const { return sd_[j]; }
+  S innovation(int i) const { return eps_[i]; }
+  int alarm_story() const { return detected_ ? story_ + 1 : 0; }  // 1-based, 0: none
+  bool detected() const { return detected_; }
+  bool device_alarm() const { return device_alarm_; }
+
+ private:
+  // ---- image decoding ------------------------------------------------------
+  void byte(std::uint8_t b) {
+    const std::size_t fixed = 4 + 2 + 7;
+    if (pos_ < fixed) return header(b);
+    if (pos_ < twin_header_bytes(d_)) return index(b);
+    raw_ |= static_cast<std::uint64_t>(b) << (8 * nbyte_);
+    ++pos_;
+    if (++nbyte_ < 8) return;
+    double v;
+    std::memcpy(&v, &raw_, 8);
+    raw_ = 0;
+    nbyte_ = 0;
+    if (value_ >= twin_values(d_)) {
+      failed_ = "twin image: longer than its dimensions";
+      return;
+    }
+    if (!std::isfinite(v)) {
+      failed_ = "twin image: a value is not finite";
+      return;
+    }
+    put(value_++, v);
+  }
+  void header(std::uint8_t b) {
+    const std::size_t i = pos_++;
+    if (i < 4) {
+      if (b != kTwinMagic[i]) failed_ = "twin image: not a twin image";
+      if (i == 0) raw_ = 0, nbyte_ = 0, value_ = 0;
+      return;
+    }
+    if (i == 4) ver_ = b;
+    if (i == 5 && (ver_ | b << 8) != kTwinVersion) failed_ = "twin image: another version";
+    if (i == 6) d_.stories = b;
+    if (i == 7) {
+      if (b > static_cast<std::uint8_t>(TwinExtra::kTmd)) failed_ = "twin image: unknown device state";
+      d_.extra = static_cast<TwinExtra>(b);
+    }
+    if (i == 8) d_.ny = b;
+    if (i == 9) d_.np = b;
+    if (i == 10) d_.nx = b;
+    if (i == 11) d_.nq = b;
+    if (i == 12) {
+      device_dof_ = b;
+      const TwinDims e = twin_dims(d_.stories, d_.extra, d_.ny);
+      if (d_.stories < 1 || d_.stories > N) failed_ = "twin image: more stories than this node holds";
+      else if (d_.ny < 1 || d_.ny > kY) failed_ = "twin image: 1 to 8 sensors";
+      else if (e.nq != d_.nq || e.nx != d_.nx || e.np != d_.np) failed_ = "twin image: inconsistent dimensions";
+    }
+  }
+  void index(std::uint8_t b) {
+    const std::size_t i = pos_++ - (4 + 2 + 7);
+    const std::size_t y = d_.ny, p = d_.np;
+    if (i < y) sensor_[i] = b;
+    else if (i < y + p) spring_a_[i - y] = b;
+    else spring_b_[i - y - p] = b;
+  }
+  // The v-th value after the header, into its place.
+  void put(std::size_t v, double x) {
+    const std::size_t nx = d_.nx, np = d_.np, ny = d_.ny;
+    const S s = static_cast<S>(x);
+    std::size_t o = kTwinSettings;
+    if (v < o) {
+      set_[v] = x;
+      return;
+    }
+    auto in = [&](std::size_t count) {
+      const bool here = v < o + count;
+      if (!here) o += count;
+      return here;
+    };
+    if (in(nx * nx)) dA_[(v - o) / nx][(v - o) % nx] = s;
+    else if (in(nx)) B0_[v - o] = s;
+    else if (in(nx)) B1_[v - o] = s;
+    else if (in(np * nx)) G_[(v - o) / nx][(v - o) % nx] = s;
+    else if (in(nx * ny)) L_[(v - o) / ny][(v - o) % ny] = s;
+    else if (in(ny * nx)) C_[(v - o) / nx][(v - o) % nx] = s;
+    else if (in(ny * np)) H_[(v - o) / np][(v - o) % np] = s;
+    else if (in(nx)) top_c_[v - o] = s;
+    else if (in(np)) top_h_[v - o] = s;
+    else if (in(np)) cd_[v - o] = s;
+    else var_[v - o] = s;
+  }
+  // The decoded image's indices and settings make sense for this node.
+  const char* check() {
+    const int nq = d_.nq;
+    for (int i = 0; i < d_.ny; ++i)
+      if (sensor_[i] >= d_.stories) return "twin image: a sensor off the frame";
+    for (int j = 0; j < d_.np; ++j)
+      if (spring_b_[j] >= nq || (spring_a_[j] != kNone8 && spring_a_[j] >= nq)) return "twin image: a spring off the frame";
+    if (d_.extra == TwinExtra::kForce && device_dof_ >= d_.stories) return "twin image: the device floor is off the frame";
+    const double* c = set_;
+    if (!(c[kForget] > 0 && c[kForget] <= 1) || !(c[kPriorInfo] > 0) || !(c[kUpdateSteps] >= 1 && c[kUpdateSteps] <= 1e6) ||
+        !(c[kKappa] >= 0) || !(c[kLossMin] >= 0) || !(c[kDeviceLossMin] >= 0) || !(c[kHoldSteps] >= 0) ||
+        !(c[kInnovAlpha] > 0 && c[kInnovAlpha] <= 1) || !(c[kLossLow] < 0 && c[kLossHigh] > 0 && c[kLossHigh] < 1) ||
+        !(c[kPeriod] > 0) || !(c[kMaxStep] > 0))
+      return "twin image: a setting out of range";
+    for (int i = 0; i < d_.ny; ++i)
+      if (!(var_[i] > S(0))) return "twin image: an innovation variance is not positive";
+    update_steps_ = static_cast<long>(c[kUpdateSteps]);
+    hold_steps_ = static_cast<long>(c[kHoldSteps]);
+    return nullptr;
+  }
+
+  // ---- filter ----------------------------------------------------------------
+  static S dot(const S* a, const S* b, int n) {
+    S t(0);
+    for (int i = 0; i < n; ++i) t += a[i] * b[i];
+    return t;
+  }
+  // Spring j's damage signal on state z: its drift and, with stiffness-
+  // proportional damping, c_d times its rate.
+  S w(int j, const S* z) const {
+    const int nq = d_.nq, a = spring_a_[j], b = spring_b_[j];
+    const S d = z[b] - (a == kNone8 ? S(0) : z[a]);
+    const S r = z[nq + b] - (a == kNone8 ? S(0) : z[nq + a]);
+    return d + cd_[j] * r;
+  }
+
+  // z <- z + dA z + B0 a0 + B1 a1 + sum_j G_j loss_j w_j(z); each sensitivity
+  // s_j <- s_j + dA s_j + G_j w_j(z).
+  void predict(S a1) {
+    const int nx = d_.nx, np = d_.np;
+    S wz[kP];
+    for (int j = 0; j < np; ++j) wz[j] = w(j, z_);
+    S zn[kX];
+    for (int i = 0; i < nx; ++i) {
+      S t = z_[i] + dot(dA_[i], z_, nx) + B0_[i] * a_ + B1_[i] * a1;
+      for (int j = 0; j < np; ++j) t += G_[j][i] * loss_[j] * wz[j];
+      zn[i] = t;
+    }
+    for (int i = 0; i < nx; ++i) z_[i] = zn[i];
+    for (int j = 0; j < np; ++j) {
+      S* s = s_[j];
+      for (int i = 0; i < nx; ++i) zn[i] = s[i] + dot(dA_[i], s, nx) + G_[j][i] * wz[j];
+      for (int i = 0; i < nx; ++i) s[i] = zn[i];
+    }
+    a_ = a1;
+  }
+
+  // The measurement update and the losses' information: innovation eps =
+  // y - C z - sum_j H_j loss_j w_j(z); psi_j = C s_j + H_j w_j(z) its
+  // sensitivity to loss_j; z += L eps, s_j -= L psi_j.
+  void update(const double* y, int ny) {
+    if (!y || ny != d_.ny) {
+      for (int i = 0; i < kY; ++i) eps_[i] = S(0);
+      return;
+    }
+    const int nx = d_.nx, np = d_.np;
+    S wz[kP];
+    for (int j = 0; j < np; ++j) wz[j] = w(j, z_);
+    S psi[kY][kP];
+    for (int i = 0; i < ny; ++i) {
+      S yh = dot(C_[i], z_, nx);
+      for (int j = 0; j < np; ++j) {
+        yh += H_[i][j] * loss_[j] * wz[j];
+        psi[i][j] = dot(C_[i], s_[j], nx) + H_[i][j] * wz[j];
+      }
+      eps_[i] = static_cast<S>(y[i]) - yh;
+    }
+    for (int r = 0; r < nx; ++r) z_[r] += dot(L_[r], eps_, ny);
+    for (int j = 0; j < np; ++j)
+      for (int r = 0; r < nx; ++r) {
+        S t(0);
+        for (int i = 0; i < ny; ++i) t += L_[r][i] * psi[i][j];
+        s_[j][r] -= t;
+      }
+    // Information with forgetting, each channel weighted by its running
+    // innovation mean square (never below the design's innovation variance).
+    const S lam = static_cast<S>(set_[kForget]), alpha = static_cast<S>(set_[kInnovAlpha]);
+    for (int a = 0; a < np; ++a) {
+      g_[a] *= lam;
+      for (int b = 0; b <= a; ++b) J_[a][b] *= lam;
+    }
+    for (int i = 0; i < ny; ++i) {
+      r2_[i] += alpha * (eps_[i] * eps_[i] - r2_[i]);
+      const S wt = S(1) / (r2_[i] > var_[i] ? r2_[i] : var_[i]);
+      for (int a = 0; a < np; ++a) {
+        const S pa = wt * psi[i][a];
+        g_[a] += pa * eps_[i];
+        for (int b = 0; b <= a; ++b) J_[a][b] += pa * psi[i][b];
+      }
+    }
+  }
+
+  // Cholesky of J + prior (lower, in place of a copy); false if not positive.
+  bool factor(S (&F)[kP][kP]) const {
+    const int np = d_.np;
+    const S prior = static_cast<S>(set_[kPriorInfo]);
+    for (int a = 0; a < np; ++a)
+      for (int b = 0; b <= a; ++b) {
+        S t = J_[a][b] + (a == b ? prior : S(0));
+        for (int c = 0; c < b; ++c) t -= F[a][c] * F[b][c];
+        if (a == b) {
+          if (!(t > S(0))) return false;
+          F[a][a] = std::sqrt(t);
+        } else {
+          F[a][b] = t / F[b][b];
+        }
+      }
+    return true;
+  }
+  // Gauss-Newton step on the losses from the gradient since the last one.
+  void solve() {
+    const int np = d_.np;
+    S F[kP][kP];
+    if (!factor(F)) return;
+    S u[kP];
+    for (int a = 0; a < np; ++a) {
+      S t = g_[a];
+      for (int c = 0; c < a; ++c) t -= F[a][c] * u[c];
+      u[a] = t / F[a][a];
+    }
+    for (int a = np - 1; a >= 0; --a) {
+      S t = u[a];
+      for (int c = a + 1; c < np; ++c) t -= F[c][a] * u[c];
+      u[a] = t / F[a][a];
+    }
+    // A trust region: no loss moves by more than kMaxStep an update (the
+    // sensitivities are a linearisation; a long step on little information
+    // lands where they no longer hold).
+    const S lo = static_cast<S>(set_[kLossLow]), hi = static_cast<S>(set_[kLossHigh]);
+    const S cap = static_cast<S>(set_[kMaxStep]);
+    for (int a = 0; a < np; ++a) {
+      const S step = u[a] < -cap ? -cap : (u[a] > cap ? cap : u[a]);
+      const S v = loss_[a] + step;
+      loss_[a] = v < lo ? lo : (v > hi ? hi : v);
+      g_[a] = S(0);
+    }
+    sds(F);
+  }
+  void refresh_sd() {
+    S F[kP][kP];
+    if (factor(F)) sds(F);
+  }
+  // Standard deviations: the diagonal of (J + prior)^-1 from its factor,
+  // column by column (e_a solved forward, its squared norm).
+  void sds(const S (&F)[kP][kP]) {
+    const int np = d_.np;
+    for (int a = 0; a < np; ++a) {
+      S v[kP];
+      S ss(0);
+      for (int r = a; r < np; ++r) {
+        S t = r == a ? S(1) : S(0);
+        for (int c = a; c < r; ++c) t -= F[r][c] * v[c];
+        v[r] = t / F[r][r];
+        ss += v[r] * v[r];
+      }
+      sd_[a] = std::sqrt(ss);
+    }
+  }
+
+  // The decision: a story whose loss is beyond kappa sd and the smallest
+  // size, held for the hold time, raises the alarm (latched); the story
+  // reported is the strongest candidate (largest loss over its threshold).
+  // The TMD's spring: the same on |loss| with its own size.
+  void decide() {
+    const S kappa = static_cast<S>(set_[kKappa]);
+    int best = -1;
+    S best_ratio(0);
+    for (int j = 0; j < d_.np; ++j) {
+      const bool tmd = j >= d_.stories;
+      const S size = tmd ? (loss_[j] < S(0) ? -loss_[j] : loss_[j]) : loss_[j];
+      const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
+      const S thr = kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
+      const bool candidate = size > thr;
+      held_[j] = candidate ? held_[j] + update_steps_ : 0;
+      if (tmd) {
+        if (held_[j] >= hold_steps_) device_alarm_ = true;
+        continue;
+      }
+      if (held_[j] >= hold_steps_ && (best < 0 || size / thr > best_ratio)) best = j, best_ratio = size / thr;
+    }
+    if (best >= 0) {
+      detected_ = true;
+      story_ = best;
+    }
+  }
+
+  // image
+  TwinDims d_;
+  std::size_t pos_ = 0, value_ = 0;
+  int nbyte_ = 0;
+  std::uint64_t raw_ = 0;
+  std::uint8_t ver_ = 0, device_dof_ = kNone8;
+  const char* failed_ = nullptr;
+  bool ready_ = false;
+  double set_[kTwinSettings] = {};
+  std::uint8_t sensor_[kY] = {}, spring_a_[kP] = {}, spring_b_[kP] = {};
+  S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, L_[kX][kY] = {}, C_[kY][kX] = {};
+  S H_[kY][kP] = {}, top_c_[kX] = {}, top_h_[kP] = {}, cd_[kP] = {}, var_[kY] = {};
+  long update_steps_ = 1, hold_steps_ = 0;
+  // state
+  S z_[kX] = {}, s_[kP][kX] = {}, a_ = S(0);
+  S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
+  S r2_[kY] = {}, eps_[kY] = {};
+  long held_[kP] = {};
+  long k_ = 0, since_ = 0;
+  int story_ = -1;
+  bool detected_ = false, device_alarm_ = false;
+};
+
+}  // namespace vines::twin

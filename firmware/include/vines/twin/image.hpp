@@ -1,0 +1,86 @@
+// The twin image: what the host designs for a twin node's estimator
+// (docs/twin.md) and sends in the configuration's model-image part, as it
+// sends a core model image in replay mode and a hybrid frame image in hybrid
+// mode. The node builds nothing: no eigensolver, no matrix exponential, no
+// Riccati equation; it streams the image into its estimator's storage.
+//
+// Layout, little-endian (wire.hpp):
+//   "VNTW", u16 version, u8 stories, u8 extra (TwinExtra), u8 ny, u8 np,
+//   u8 nx, u8 nq, u8 device_dof (255: none), u8 sensor_dof[ny],
+//   u8 spring_a[np] (255: ground), u8 spring_b[np],
+//   f64 settings[kTwinSettings] (TwinSetting order),
+//   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], L[nx][ny], C[ny][nx],
+//   H[ny][np], top_c[nx], top_h[np], spring_cd[np], innovation_var[ny]
+// (matrices row-major: dA = Phi - I, the discrete transition less identity;
+// see docs/twin.md for each).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#include "vines/link/wire.hpp"
+#include "vines/params.hpp"
+
+namespace vines::twin {
+
+// Floor accelerometers a twin node reads at most.
+inline constexpr int kMaxSensors = 8;
+inline constexpr std::uint8_t kNone8 = 255;  // "ground" (a spring's end) or "no device DOF"
+
+inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
+inline constexpr std::uint16_t kTwinVersion = 1;
+
+// The state beyond the frame's 2N: none (bare frame), the device's force on
+// its floor as an unknown input (VI NES: one state), or the TMD's own mass
+// (two states, its spring one more parameter).
+enum class TwinExtra : std::uint8_t { kNone = 0, kForce = 1, kTmd = 2 };
+
+// Scalar settings of the estimator, in the image in this order.
+enum TwinSetting : int {
+  kForget,        // information kept per step (exp(-h / memory))
+  kPriorInfo,     // prior information on each loss (1 / sd0^2)
+  kUpdateSteps,   // steps between parameter updates
+  kKappa,         // a loss is a candidate beyond kappa standard deviations...
+  kLossMin,       // ...and beyond this size (stories)
+  kDeviceLossMin, // the TMD spring's candidate size (|loss|)
+  kHoldSteps,     // a candidate held this long is an alarm
+  kInnovAlpha,    // weight of a step in the innovations' running mean square
+  kForceScale,    // device force state to N (the device floor's mass)
+  kLossLow,       // estimates clamped to [low, high]
+  kLossHigh,
+  kPeriod,        // h [s]
+  kMaxStep,       // largest change of a loss in one update
+  kTwinSettings
+};
+
+struct TwinDims {
+  int stories = 0, nq = 0, nx = 0, np = 0, ny = 0;
+  TwinExtra extra = TwinExtra::kNone;
+};
+
+// Dimensions of a twin of n stories with extra state e and ny sensors.
+inline TwinDims twin_dims(int n, TwinExtra e, int ny) {
+  TwinDims d;
+  d.stories = n;
+  d.extra = e;
+  d.nq = n + (e == TwinExtra::kTmd ? 1 : 0);
+  d.nx = 2 * d.nq + (e == TwinExtra::kForce ? 1 : 0);
+  d.np = n + (e == TwinExtra::kTmd ? 1 : 0);
+  d.ny = ny;
+  return d;
+}
+
+// Bytes before the matrices, and the number of f64 values after them.
+inline std::size_t twin_header_bytes(const TwinDims& d) {
+  return 4 + 2 + 7 + static_cast<std::size_t>(d.ny) + 2 * static_cast<std::size_t>(d.np);
+}
+inline std::size_t twin_values(const TwinDims& d) {
+  const std::size_t x = d.nx, p = d.np, y = d.ny;
+  return kTwinSettings + x * x + 2 * x + p * x + 2 * x * y + y * p + x + 2 * p + y;
+}
+inline bool is_twin_image(const std::uint8_t* p, std::size_t n) {
+  return p != nullptr && n >= 4 && std::memcmp(p, kTwinMagic, 4) == 0;
+}
+
+}  // namespace vines::twin
