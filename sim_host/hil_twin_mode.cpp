@@ -169,18 +169,19 @@ class TwinMode : public BenchMode {
     // force's regression on the estimated top-floor acceleration (device on
     // the top floor): a stuck sphere moves with its floor, F = -m a.
     const double h = b_.h;
-    std::vector<double> F;
-    double fa = 0, aa = 0;
+    std::vector<double> F, A;
     for (long long k = 0; k < rec.samples; ++k) {
       const auto i = static_cast<std::size_t>(k);
       d->impulse_truth_ns += std::fabs(tb_.truth.device_force[i]) * h;
       if (!rec.got[i]) continue;
-      const Telemetry& t = rec.tel[i];
-      F.push_back(t.contact_force);
-      d->impulse_estimated_ns += std::fabs(t.contact_force) * h;
-      fa += t.contact_force * t.acc_top, aa += t.acc_top * t.acc_top;
+      F.push_back(rec.tel[i].contact_force);
+      A.push_back(rec.tel[i].acc_top);
+      d->impulse_estimated_ns += std::fabs(F.back()) * h;
     }
     const double thr = 6 * robust_sd(F);
+    double fa = 0, aa = 0;  // between impacts only: an impact pushes its floor the way it accelerates
+    for (std::size_t i = 0; i < F.size(); ++i)
+      if (std::fabs(F[i]) <= thr) fa += F[i] * A[i], aa += A[i] * A[i];
     const auto dead = static_cast<long long>(std::ceil(0.02 / h));
     long long last = -dead - 1;
     for (std::size_t i = 0; i < F.size(); ++i)

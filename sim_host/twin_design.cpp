@@ -166,13 +166,20 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   Mat R = Mat::Zero(ny, ny);
   for (int i = 0; i < ny; ++i) R(i, i) = std::pow(std::max(noise_sd[static_cast<std::size_t>(i)], 1e-4), 2);
   TwinDesign out;
+  // Two gains for a VI NES: the force free (impacts) and held near zero
+  // (flight, most of the time); one otherwise.
   const Mat P = riccati(z.Phi, Cm, Q, R, &out.riccati_iterations);
-  const Mat S = Cm * P * Cm.transpose() + R;
-  const Mat L = P * Cm.transpose() * S.inverse();
-  const Mat Ppost = (Mat::Identity(nx, nx) - L * Cm) * P;
+  Mat Qq = Q;
+  if (d.extra == TwinExtra::kForce) Qq(2 * nq, 2 * nq) *= t.quiet_force_share * t.quiet_force_share;
+  int quiet_iterations = 0;
+  const Mat Pq = d.extra == TwinExtra::kForce ? riccati(z.Phi, Cm, Qq, R, &quiet_iterations) : P;
+  const Mat L = P * Cm.transpose() * (Cm * P * Cm.transpose() + R).inverse();
+  const Mat S = Cm * Pq * Cm.transpose() + R;
+  const Mat Lq = Pq * Cm.transpose() * S.inverse();
+  const Mat Ppost = (Mat::Identity(nx, nx) - Lq * Cm) * Pq;
   out.roof_sd_m = std::sqrt(std::max(0.0, Ppost(d.stories - 1, d.stories - 1)));
   for (int i = 0; i < ny; ++i) out.innovation_sd.push_back(std::sqrt(S(i, i)));
-  if (!L.allFinite()) throw std::runtime_error("the twin's Kalman gain is not finite");
+  if (!L.allFinite() || !Lq.allFinite()) throw std::runtime_error("the twin's Kalman gain is not finite");
 
   // The image.
   std::vector<std::uint8_t> buf(twin::twin_header_bytes(d) + 8 * twin::twin_values(d));
@@ -198,6 +205,8 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kLossHigh] = 0.9;
   set[twin::kPeriod] = h;
   set[twin::kMaxStep] = t.max_step;
+  set[twin::kJumpSigma] = t.jump_sigma;
+  set[twin::kJumpHold] = std::round(t.jump_hold_s / h);
   for (double v : set) w.f64(v);
   const Mat dA = z.Phi - Mat::Identity(nx, nx);
   const Vec top_c = c.Cy.row(d.stories - 1), top_h = c.Hy.row(d.stories - 1);
@@ -210,6 +219,7 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   put(z.B1.transpose());
   put(z.G.transpose());
   put(L);
+  put(Lq);
   put(Cm);
   put(Hm);
   put(top_c.transpose());

@@ -63,6 +63,7 @@ class Estimator {
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
     k_ = 0;
     since_ = 0;
+    impact_left_ = 0;
     story_ = -1;
     detected_ = false;
     device_alarm_ = false;
@@ -173,6 +174,7 @@ class Estimator {
     else if (in(nx)) B1_[v - o] = s;
     else if (in(np * nx)) G_[(v - o) / nx][(v - o) % nx] = s;
     else if (in(nx * ny)) L_[(v - o) / ny][(v - o) % ny] = s;
+    else if (in(nx * ny)) Lq_[(v - o) / ny][(v - o) % ny] = s;
     else if (in(ny * nx)) C_[(v - o) / nx][(v - o) % nx] = s;
     else if (in(ny * np)) H_[(v - o) / np][(v - o) % np] = s;
     else if (in(nx)) top_c_[v - o] = s;
@@ -192,7 +194,7 @@ class Estimator {
     if (!(c[kForget] > 0 && c[kForget] <= 1) || !(c[kPriorInfo] > 0) || !(c[kUpdateSteps] >= 1 && c[kUpdateSteps] <= 1e6) ||
         !(c[kKappa] >= 0) || !(c[kLossMin] >= 0) || !(c[kDeviceLossMin] >= 0) || !(c[kHoldSteps] >= 0) ||
         !(c[kInnovAlpha] > 0 && c[kInnovAlpha] <= 1) || !(c[kLossLow] < 0 && c[kLossHigh] > 0 && c[kLossHigh] < 1) ||
-        !(c[kPeriod] > 0) || !(c[kMaxStep] > 0))
+        !(c[kPeriod] > 0) || !(c[kMaxStep] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0))
       return "twin image: a setting out of range";
     for (int i = 0; i < d_.ny; ++i)
       if (!(var_[i] > S(0))) return "twin image: an innovation variance is not positive";
@@ -249,6 +251,8 @@ class Estimator {
     S wz[kP];
     for (int j = 0; j < np; ++j) wz[j] = w(j, z_);
     S psi[kY][kP];
+    const S jump = static_cast<S>(set_[kJumpSigma]);
+    bool impact = false;
     for (int i = 0; i < ny; ++i) {
       S yh = dot(C_[i], z_, nx);
       for (int j = 0; j < np; ++j) {
@@ -256,12 +260,19 @@ class Estimator {
         psi[i][j] = dot(C_[i], s_[j], nx) + H_[i][j] * wz[j];
       }
       eps_[i] = static_cast<S>(y[i]) - yh;
+      impact = impact || eps_[i] * eps_[i] > jump * jump * var_[i];
     }
-    for (int r = 0; r < nx; ++r) z_[r] += dot(L_[r], eps_, ny);
+    // The gain: the quiet one (the device's force held near zero) unless an
+    // innovation jumps beyond kJumpSigma of its quiet sd, then the impact
+    // one (the force free) for kJumpHold steps.
+    if (impact) impact_left_ = static_cast<long>(set_[kJumpHold]);
+    const S(*L)[kY] = impact_left_ > 0 ? L_ : Lq_;
+    if (impact_left_ > 0) --impact_left_;
+    for (int r = 0; r < nx; ++r) z_[r] += dot(L[r], eps_, ny);
     for (int j = 0; j < np; ++j)
       for (int r = 0; r < nx; ++r) {
         S t(0);
-        for (int i = 0; i < ny; ++i) t += L_[r][i] * psi[i][j];
+        for (int i = 0; i < ny; ++i) t += L[r][i] * psi[i][j];
         s_[j][r] -= t;
       }
     // Information with forgetting, each channel weighted by its running
@@ -386,7 +397,8 @@ class Estimator {
   bool ready_ = false;
   double set_[kTwinSettings] = {};
   std::uint8_t sensor_[kY] = {}, spring_a_[kP] = {}, spring_b_[kP] = {};
-  S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, L_[kX][kY] = {}, C_[kY][kX] = {};
+  S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, L_[kX][kY] = {}, Lq_[kX][kY] = {};
+  S C_[kY][kX] = {};
   S H_[kY][kP] = {}, top_c_[kX] = {}, top_h_[kP] = {}, cd_[kP] = {}, var_[kY] = {};
   long update_steps_ = 1, hold_steps_ = 0;
   // state
@@ -394,7 +406,7 @@ class Estimator {
   S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
   S r2_[kY] = {}, eps_[kY] = {};
   long held_[kP] = {};
-  long k_ = 0, since_ = 0;
+  long k_ = 0, since_ = 0, impact_left_ = 0;
   int story_ = -1;
   bool detected_ = false, device_alarm_ = false;
 };

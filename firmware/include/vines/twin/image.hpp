@@ -9,8 +9,11 @@
 //   u8 nx, u8 nq, u8 device_dof (255: none), u8 sensor_dof[ny],
 //   u8 spring_a[np] (255: ground), u8 spring_b[np],
 //   f64 settings[kTwinSettings] (TwinSetting order),
-//   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], L[nx][ny], C[ny][nx],
-//   H[ny][np], top_c[nx], top_h[np], spring_cd[np], innovation_var[ny]
+//   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], L[nx][ny], Lq[nx][ny],
+//   C[ny][nx], H[ny][np], top_c[nx], top_h[np], spring_cd[np],
+//   innovation_var[ny]
+// (L the gain with the device's force free, Lq with it held near zero: the
+// same but for a VI NES; innovation_var the quiet design's)
 // (matrices row-major: dA = Phi - I, the discrete transition less identity;
 // see docs/twin.md for each).
 #pragma once
@@ -51,6 +54,8 @@ enum TwinSetting : int {
   kLossHigh,
   kPeriod,        // h [s]
   kMaxStep,       // largest change of a loss in one update
+  kJumpSigma,     // an innovation beyond this many quiet sd: the impact gain...
+  kJumpHold,      // ...for this many steps
   kTwinSettings
 };
 
@@ -77,7 +82,7 @@ inline std::size_t twin_header_bytes(const TwinDims& d) {
 }
 inline std::size_t twin_values(const TwinDims& d) {
   const std::size_t x = d.nx, p = d.np, y = d.ny;
-  return kTwinSettings + x * x + 2 * x + p * x + 2 * x * y + y * p + x + 2 * p + y;
+  return kTwinSettings + x * x + 2 * x + p * x + 3 * x * y + y * p + x + 2 * p + y;
 }
 inline bool is_twin_image(const std::uint8_t* p, std::size_t n) {
   return p != nullptr && n >= 4 && std::memcmp(p, kTwinMagic, 4) == 0;
