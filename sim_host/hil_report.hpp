@@ -67,7 +67,7 @@ struct HilTwinDevice {
   // VI NES
   double impulse_estimated_ns = 0, impulse_truth_ns = 0;
   long long impacts_estimated = 0, contacts_truth = 0;
-  double added_mass_ratio = 0;   // the force's regression on the floor's acceleration, over the sphere's mass
+  double added_mass_ratio = 0;   // the mass the device's floor gained (estimated), over the sphere's
   std::string sphere;            // "moving", "stuck" (moves with its floor) or "still" (no impact seen)
   // TMD
   double frequency_factor = 1, frequency_factor_sd = 0, truth_frequency_factor = 1;

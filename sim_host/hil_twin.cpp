@@ -91,7 +91,6 @@ TwinBench make_twin_bench(const Scene& scene, const HilOptions& o, const Excitat
   }
   const ModelInfo ti = eng->info();
   tr.contacts = eng->totals().count.contacts;
-  tr.particle_mass = ti.vines.mass;
 
   // The sensors: noise (absolute, or a share of each channel's RMS), a bias
   // drawn once per sensor, ADC quantisation; all from the seed.
@@ -123,6 +122,7 @@ TwinBench make_twin_bench(const Scene& scene, const HilOptions& o, const Excitat
   // The node's estimator, designed on the node's scene (the nominal model).
   const std::unique_ptr<Engine> nominal = build_engine(scene.params, Scalar::kDouble, scene.path);
   const ModelInfo ni = nominal->info();
+  tr.particle_mass = ni.vines.mass;  // the sphere the node's scene designs
   if (ni.tmd.omega > 0 && truth.params.device.kind == DeviceKind::kTmd) tr.tmd_frequency_factor = ti.tmd.omega / ni.tmd.omega;
   if (o.estimator == HilEstimator::kKalman) tb.design = design_twin(scene.params, ni, tb.sensors, tb.noise_sd, o.tuning);
   return tb;

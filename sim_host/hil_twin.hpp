@@ -22,7 +22,7 @@ struct TwinTruth {
   std::vector<double> roof_x;       // top-floor displacement [m]
   std::vector<double> device_force; // VI NES: the device's force on its floor [N]; TMD, none: 0
   double tmd_frequency_factor = 1;  // truth TMD frequency / the node's design
-  double particle_mass = 0;         // VI NES sphere [kg]
+  double particle_mass = 0;         // the node's VI NES sphere [kg] (its design)
   long long contacts = 0;
 };
 

@@ -60,7 +60,7 @@ class TwinMode : public BenchMode {
   // story in alarm, the truth's device force.
   CsvColumns csv_columns(const HilRecord& rec) const override {
     CsvColumns c;
-    const int n = b_.scene.params.frame.stories, np = springs();
+    const int np = params();
     c.names.push_back("x_top_truth_m");
     c.names.push_back("device_force_truth_n");
     if (!estimator_) {
@@ -68,8 +68,8 @@ class TwinMode : public BenchMode {
         c.rows.push_back({tb_.truth.roof_x[static_cast<std::size_t>(k)], tb_.truth.device_force[static_cast<std::size_t>(k)]});
       return c;
     }
-    for (int j = 0; j < np; ++j) c.names.push_back(j < n ? "eta_" + std::to_string(j + 1) : "eta_tmd");
-    for (int j = 0; j < np; ++j) c.names.push_back(j < n ? "eta_sd_" + std::to_string(j + 1) : "eta_sd_tmd");
+    for (int j = 0; j < np; ++j) c.names.push_back("eta_" + param_name(j));
+    for (int j = 0; j < np; ++j) c.names.push_back("eta_sd_" + param_name(j));
     c.names.push_back("alarm_story");
     Factors f(np);
     int alarm = 0;
@@ -86,8 +86,13 @@ class TwinMode : public BenchMode {
   }
 
  private:
-  int springs() const {
-    return b_.scene.params.frame.stories + (b_.scene.params.device.kind == DeviceKind::kTmd ? 1 : 0);
+  // The estimator's parameters: the stories, then the TMD's spring or the
+  // VI NES floor's mass.
+  int params() const { return stories() + (device() == DeviceKind::kNone ? 0 : 1); }
+  int stories() const { return b_.scene.params.frame.stories; }
+  DeviceKind device() const { return b_.scene.params.device.kind; }
+  std::string param_name(int j) const {
+    return j < stories() ? std::to_string(j + 1) : device() == DeviceKind::kTmd ? "tmd" : "device_floor_mass";
   }
 
   // The top floor's measured-minus-twin residual, its alarms, the drift
@@ -122,7 +127,7 @@ class TwinMode : public BenchMode {
   // The estimator's decision and factors, the roof against the truth, the
   // device's health.
   void estimates(const HilRecord& rec, HilTwinReport* tw) const {
-    const int n = b_.scene.params.frame.stories, np = springs();
+    const int n = b_.scene.params.frame.stories, np = params();
     Factors f(np);
     double se = 0, st = 0;
     bool device_alarm = false;
@@ -153,11 +158,12 @@ class TwinMode : public BenchMode {
 
   void device(const HilRecord& rec, const Factors& f, bool alarm, HilTwinDevice* d) const {
     const DeviceParams& dp = b_.scene.params.device;
+    const int n = stories();
     if (dp.kind == DeviceKind::kTmd) {
-      const double eta = std::max(f.eta.back(), 1e-9);
+      const double eta = std::max(f.eta[static_cast<std::size_t>(n)], 1e-9);
       d->kind = "tmd";
       d->frequency_factor = std::sqrt(eta);
-      d->frequency_factor_sd = 0.5 * f.sd.back() / std::sqrt(eta);
+      d->frequency_factor_sd = 0.5 * f.sd[static_cast<std::size_t>(n)] / std::sqrt(eta);
       d->truth_frequency_factor = tb_.truth.tmd_frequency_factor;
       d->detuned = alarm;
       return;
@@ -166,30 +172,27 @@ class TwinMode : public BenchMode {
     d->kind = "vines";
     // Impulses: |F| integrated, the node's estimate and the truth's; impacts:
     // excursions of |F| beyond 6 robust sd of the estimate, 20 ms apart; the
-    // force's regression on the estimated top-floor acceleration (device on
-    // the top floor): a stuck sphere moves with its floor, F = -m a.
+    // mass the device floor gained, over the sphere's: a stuck sphere moves
+    // with its floor.
     const double h = b_.h;
-    std::vector<double> F, A;
+    std::vector<double> F;
     for (long long k = 0; k < rec.samples; ++k) {
       const auto i = static_cast<std::size_t>(k);
       d->impulse_truth_ns += std::fabs(tb_.truth.device_force[i]) * h;
       if (!rec.got[i]) continue;
       F.push_back(rec.tel[i].contact_force);
-      A.push_back(rec.tel[i].acc_top);
       d->impulse_estimated_ns += std::fabs(F.back()) * h;
     }
     const double thr = 6 * robust_sd(F);
-    double fa = 0, aa = 0;  // between impacts only: an impact pushes its floor the way it accelerates
-    for (std::size_t i = 0; i < F.size(); ++i)
-      if (std::fabs(F[i]) <= thr) fa += F[i] * A[i], aa += A[i] * A[i];
     const auto dead = static_cast<long long>(std::ceil(0.02 / h));
     long long last = -dead - 1;
     for (std::size_t i = 0; i < F.size(); ++i)
       if (std::fabs(F[i]) > thr && static_cast<long long>(i) - last > dead) ++d->impacts_estimated, last = static_cast<long long>(i);
       else if (std::fabs(F[i]) > thr) last = static_cast<long long>(i);
     d->contacts_truth = tb_.truth.contacts;
-    const double mp = tb_.truth.particle_mass > 0 ? tb_.truth.particle_mass : 1.0;
-    d->added_mass_ratio = aa > 0 ? -fa / aa / mp : 0.0;
+    const int floor = (dp.floor > 0 ? dp.floor : n) - 1;
+    const double md = b_.scene.params.frame.mass_kg[floor], mp = tb_.truth.particle_mass;
+    d->added_mass_ratio = mp > 0 ? (f.eta[static_cast<std::size_t>(n)] - 1.0) * md / mp : 0.0;
     d->sphere = d->added_mass_ratio > 0.5 ? "stuck" : d->impacts_estimated == 0 ? "still" : "moving";
   }
 

@@ -20,13 +20,14 @@ using twin::TwinDims;
 using twin::TwinExtra;
 
 // The continuous model of docs/twin.md section 2: DOFs q (floors, then the
-// TMD), state z = (q, q', f), z' = A z + Bg a_g + sum_j E_j w_j; floor
-// accelerations y = Cy z + sum_j Hy_j w_j.
+// TMD), state z = (q, q', f), z' = A z + Bg a_g + sum_j E_j p_j w_j; floor
+// accelerations y = Cy z + sum_j Hy_j p_j w_j; parameter j's signal
+// w_j = W_j z.
 struct Continuous {
   TwinDims d;
-  Mat A, E, Cy, Hy;  // E: nx x np, Cy: nq x nx (every DOF's absolute acceleration), Hy: nq x np
-  Vec Bg, cd;
-  std::vector<int> a, b;  // spring ends (-1: ground)
+  Mat A, E, Cy, Hy, W;  // E: nx x np, Cy: nq x nx (every DOF's absolute acceleration), Hy: nq x np, W: np x nx
+  Vec Bg, prior_sd;
+  std::vector<twin::TwinParam> kind;
   int device = -1;        // the force's DOF (VI NES)
   double device_mass = 1;
 };
@@ -48,19 +49,22 @@ Continuous continuous(const SceneParams& p, const ModelInfo& info, int ny, const
     m(i) = f.m[static_cast<std::size_t>(i)];
     for (int j = 0; j < n; ++j) K(i, j) = f.K_at(i, j), C(i, j) = f.C_at(i, j);
   }
-  c.cd = Vec::Zero(np);
-  for (int j = 0; j < n; ++j) {
-    c.a.push_back(j - 1), c.b.push_back(j);
-    if (p.frame.damping == DampingRule::kStiffnessProportional) c.cd(j) = p.frame.stiffness_damping_s;
-  }
-  std::vector<double> k(f.k.begin(), f.k.end());
+  // Springs: story j links floor j-1 (or the ground) and floor j, with
+  // stiffness-proportional damping its rate too; the TMD's links its floor
+  // and its mass.
+  struct Spring {
+    int a, b;
+    double k, cd;
+  };
+  std::vector<Spring> springs;
+  const double cd = p.frame.damping == DampingRule::kStiffnessProportional ? p.frame.stiffness_damping_s : 0.0;
+  for (int j = 0; j < n; ++j) springs.push_back({j - 1, j, f.k[static_cast<std::size_t>(j)], cd});
   if (extra == TwinExtra::kTmd) {
     const TmdDesign& td = info.tmd;
     m(n) = td.mass;
     K(dfloor, dfloor) += td.k, K(n, n) += td.k, K(dfloor, n) -= td.k, K(n, dfloor) -= td.k;
     C(dfloor, dfloor) += td.c, C(n, n) += td.c, C(dfloor, n) -= td.c, C(n, dfloor) -= td.c;
-    c.a.push_back(dfloor), c.b.push_back(n);
-    k.push_back(td.k);
+    springs.push_back({dfloor, n, td.k, 0.0});
   }
   const Vec minv = m.cwiseInverse();
   c.A = Mat::Zero(nx, nx);
@@ -78,16 +82,36 @@ Continuous continuous(const SceneParams& p, const ModelInfo& info, int ny, const
     c.A(2 * nq, 2 * nq) = -1.0 / t.force_tau_s;
     c.Cy(dfloor, 2 * nq) = 1.0;
   }
-  // Spring j's loss adds the force k_j w_j g_j (g_j = e_b - e_a) to the DOFs.
+  // Spring j's loss p_j adds the force p_j k_j w_j g_j (g_j = e_b - e_a,
+  // w_j its drift) to the DOFs; floor i's mass factor 1 - p_i the force
+  // p_i m_i a_i (a_i its absolute acceleration).
   c.E = Mat::Zero(nx, np);
   c.Hy = Mat::Zero(nq, np);
-  for (int j = 0; j < np; ++j) {
+  c.W = Mat::Zero(np, nx);
+  c.prior_sd = Vec::Zero(np);
+  for (std::size_t j = 0; j < springs.size(); ++j) {
+    const Spring& s = springs[j];
+    const int col = static_cast<int>(j);
     Vec g = Vec::Zero(nq);
-    g(c.b[j]) += 1.0;
-    if (c.a[j] >= 0) g(c.a[j]) -= 1.0;
-    const Vec acc = minv.asDiagonal() * g * k[static_cast<std::size_t>(j)];
-    c.E.col(j).segment(nq, nq) = acc;
-    c.Hy.col(j) = acc;
+    g(s.b) += 1.0;
+    if (s.a >= 0) g(s.a) -= 1.0;
+    const Vec acc = minv.asDiagonal() * g * s.k;
+    c.E.col(col).segment(nq, nq) = acc;
+    c.Hy.col(col) = acc;
+    c.W.row(col).segment(0, nq) = g.transpose();
+    c.W.row(col).segment(nq, nq) = s.cd * g.transpose();
+    c.kind.push_back(col < n ? twin::TwinParam::kStory : twin::TwinParam::kDeviceSpring);
+    c.prior_sd(col) = t.prior_sd;
+  }
+  // A VI NES's floor: its mass, which a stuck sphere adds to (the prior
+  // spans the sphere's mass).
+  if (extra == TwinExtra::kForce) {
+    const int col = n;
+    c.E(nq + dfloor, col) = 1.0;
+    c.Hy(dfloor, col) = 1.0;
+    c.W.row(col) = c.Cy.row(dfloor);
+    c.kind.push_back(twin::TwinParam::kMass);
+    c.prior_sd(col) = info.vines.mass / m(dfloor);
   }
   return c;
 }
@@ -189,11 +213,9 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   for (int v : {d.stories, static_cast<int>(d.extra), ny, np, nx, nq, c.device < 0 ? 255 : c.device})
     w.u8(static_cast<std::uint8_t>(v));
   for (int s : sensors) w.u8(static_cast<std::uint8_t>(s - 1));
-  for (int a : c.a) w.u8(static_cast<std::uint8_t>(a < 0 ? twin::kNone8 : a));
-  for (int b : c.b) w.u8(static_cast<std::uint8_t>(b));
+  for (twin::TwinParam k : c.kind) w.u8(static_cast<std::uint8_t>(k));
   double set[twin::kTwinSettings] = {};
   set[twin::kForget] = std::exp(-h / t.memory_s);
-  set[twin::kPriorInfo] = 1.0 / (t.prior_sd * t.prior_sd);
   set[twin::kUpdateSteps] = std::max(1.0, std::round(t.update_s / h));
   set[twin::kKappa] = t.kappa;
   set[twin::kLossMin] = t.loss_min;
@@ -201,10 +223,9 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);
   set[twin::kForceScale] = c.device_mass;
-  set[twin::kLossLow] = -0.5;
+  set[twin::kLossLow] = -2.0;
   set[twin::kLossHigh] = 0.9;
   set[twin::kPeriod] = h;
-  set[twin::kMaxStep] = t.max_step;
   set[twin::kJumpSigma] = t.jump_sigma;
   set[twin::kJumpHold] = std::round(t.jump_hold_s / h);
   for (double v : set) w.f64(v);
@@ -218,13 +239,17 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   put(z.B0.transpose());
   put(z.B1.transpose());
   put(z.G.transpose());
+  put(c.W);
   put(L);
   put(Lq);
   put(Cm);
   put(Hm);
   put(top_c.transpose());
   put(top_h.transpose());
-  put(c.cd.transpose());
+  // Each parameter's prior information and trust region (the stories' cap
+  // scaled by its prior sd).
+  put(c.prior_sd.cwiseAbs2().cwiseInverse().transpose());
+  put((c.prior_sd * (t.max_step / t.prior_sd)).transpose());
   put(S.diagonal().transpose());
   if (!w.ok() || w.size() != buf.size()) throw std::runtime_error("the twin image: wrong size (a bug)");
   out.image = std::move(buf);

@@ -28,9 +28,9 @@ struct TwinTuning {
   double update_s = 0.05;        // parameter update period
   double max_step = 0.002;       // largest change of a loss in one update (a trust region)
   double kappa = 4;              // alarm: loss beyond kappa sd...
-  double loss_min = 0.03;        // ...and beyond 3 % (stories)
+  double loss_min = 0.05;        // ...and beyond 5 % (stories)
   double device_loss_min = 0.1;  // the TMD spring: |loss| beyond 10 % (5 % in frequency)
-  double hold_s = 1.0;           // held this long
+  double hold_s = 2.0;           // held this long
   double innov_window_s = 2.0;   // the innovations' running mean square
 };
 

@@ -8,7 +8,8 @@ conditions, per contact scheme; flash and RAM (arm-none-eabi-size); stack
   tools/mcu_report.py [--vines PATH] [--targets cortex-m4f,cortex-m7]
                       [--schemes adaptive,bounded [--bounded-substeps N]]
                       [--quick] [--duration S] [--full-scene] [--records GLOB]
-                      [--only scene,records,ics,tmd,bare] [--keep-scenes DIR]
+                      [--only scene,records,ics,tmd,bare,twin_vines,twin_tmd,twin_bare]
+                      [--keep-scenes DIR]
                       [-j N] [--json]
 
 Each run is `VINES hil SCENE --node qemu:TARGET --json --image ELF
@@ -27,7 +28,10 @@ mode (contact scheme), the VI NES runs are:
            rest and u = 0 with v = +0.5 and -1.0 m/s (u = -gap at rest is the
            scene run; gap read from `VINES run`'s summary of the scene);
 and once per target, not per mode: the TMD scene (elcentro_tmd.toml) and the
-bare frame (elcentro_bare.toml) at the target's rate. --only limits the
+bare frame (elcentro_bare.toml) at the target's rate. The twin node (docs/twin.md;
+kinds twin_vines, twin_tmd, twin_bare): each device's image in twin mode
+with the estimator, El Centro at 1 kHz, floors 3, 6, 8, 10 measured with
+5 % noise (vines hil --mode twin --sensors 3,6,8,10 --measure-noise-pct 5). --only limits the
 kinds. --quick: the scene only, 3 s (or --duration). --duration S caps every
 run (vines hil --duration), except the scene run with --full-scene.
 Modes: without --schemes one mode, "default": no contact_scheme key is

@@ -14,7 +14,13 @@ TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate 
 }
 MARGIN = 1.5  # the step must fit in 2/3 of the period
 DEVICES = ("none", "tmd", "vines")
-KINDS = ("scene", "records", "ics", "tmd", "bare")
+KINDS = ("scene", "records", "ics", "tmd", "bare", "twin_vines", "twin_tmd", "twin_bare")
+# The twin node (docs/twin.md) on each device's image: El Centro at 1 kHz,
+# floors 3, 6, 8, 10 measured with 5 % noise; kind -> (device, scene).
+TWIN_KINDS = {"twin_vines": ("vines", "elcentro_vines.toml"), "twin_tmd": ("tmd", "elcentro_tmd.toml"),
+              "twin_bare": ("none", "elcentro_bare.toml")}
+TWIN_ARGS = ["--mode", "twin", "--sensors", "3,6,8,10", "--measure-noise-pct", "5"]
+TWIN_RATE_HZ = 1000.0
 PGA_G = 0.35
 QUICK_DURATION_S = 3.0
 SCENES = os.path.join(ROOT, "data", "scenes")

@@ -3,7 +3,7 @@ TMD and bare-frame runs (worst and median step, sustained rate, flash, RAM,
 stack), the images and every run, as the JSON object of --json or as text."""
 import re
 
-from . import DEVICES, MARGIN, QUICK_DURATION_S, TARGETS
+from . import DEVICES, MARGIN, QUICK_DURATION_S, TARGETS, TWIN_KINDS
 
 
 # The figures of one group of runs on one image (a mode's VI NES runs, or the TMD or
@@ -55,7 +55,7 @@ def report(target, jobs, images, a):
            "full_scene": a.full_scene,
            "images": {d: images[(target, d)] for d in DEVICES if (target, d) in images},
            "modes": modes}
-    for kind, dev in (("tmd", "tmd"), ("bare", "none")):
+    for kind, dev in (("tmd", "tmd"), ("bare", "none")) + tuple((k, d) for k, (d, _) in TWIN_KINDS.items()):
         mine = [r for r in runs if r["kind"] == kind]
         if mine:
             rep[kind] = figures(mine, images[(target, dev)], clock, kind)
@@ -105,7 +105,8 @@ def print_text(rep):
           + ")")
     for mode, f in rep["modes"].items():
         print("\n".join(fmt_block(f"VI NES, mode {mode}", f, rep["clock_hz"])))
-    for kind, label in (("tmd", "TMD"), ("bare", "bare frame")):
+    for kind, label in (("tmd", "TMD"), ("bare", "bare frame"), ("twin_vines", "twin node, VI NES image"),
+                        ("twin_tmd", "twin node, TMD image"), ("twin_bare", "twin node, bare-frame image")):
         if kind in rep:
             print("\n".join(fmt_block(label, rep[kind], rep["clock_hz"])))
     for d, im in rep["images"].items():

@@ -10,7 +10,7 @@ import sys
 import threading
 import time
 
-from . import KINDS, PGA_G, QUICK_DURATION_S, ROOT, TARGETS
+from . import KINDS, PGA_G, QUICK_DURATION_S, ROOT, TARGETS, TWIN_ARGS, TWIN_KINDS, TWIN_RATE_HZ
 from .images import file_hash
 from .scenes import SCENE_IC, base_scene, ic_grid, records_list, vines_gap, write_scene
 
@@ -54,6 +54,12 @@ def plan(a, tmp, records_dir):
             if kind in kinds:
                 sc = base_scene(name, target, records_dir)
                 add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap)
+        for kind, (_, name) in TWIN_KINDS.items():
+            if kind in kinds:
+                sc = base_scene(name, target, records_dir)
+                sc["loop"]["sensor_rate_hz"] = sc["output"]["rate_hz"] = TWIN_RATE_HZ
+                add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap,
+                    {"hil_args": TWIN_ARGS})
     return jobs
 
 
@@ -69,6 +75,7 @@ def run_one(vines, job):
            "--image", image_for(job)]
     if job["duration_cap_s"]:
         cmd += ["--duration", repr(float(job["duration_cap_s"]))]
+    cmd += job.get("hil_args", [])
     before = file_hash(image_for(job))
     t0 = time.monotonic()
     try:

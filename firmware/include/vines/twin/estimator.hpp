@@ -1,8 +1,9 @@
 // The twin node's estimator (docs/twin.md): a Kalman filter that keeps the
 // frame's state on the measured floor accelerations, with the device's force
 // as an unknown input (VI NES) or the TMD as two more states, and a recursive
-// prediction-error identification of each spring's stiffness loss (stories,
-// and the TMD's spring), with its uncertainty and a damage decision.
+// prediction-error identification of each story's stiffness and of the
+// device (the TMD's spring; the mass a VI NES floor carries, which a stuck
+// sphere adds to), with their uncertainty and a damage decision.
 //
 // Everything the node needs is designed on the host and streamed in as the
 // twin image (twin/image.hpp): the steady-state gain, the discrete model, the
@@ -93,6 +94,7 @@ class Estimator {
     return a;
   }
   S loss(int j) const { return loss_[j]; }                   // 1 - eta_j
+  TwinParam kind(int j) const { return static_cast<TwinParam>(kind_[j]); }
   S loss_sd(int j) const { return sd_[j]; }
   S innovation(int i) const { return eps_[i]; }
   int alarm_story() const { return detected_ ? story_ + 1 : 0; }  // 1-based, 0: none
@@ -150,10 +152,9 @@ class Estimator {
   }
   void index(std::uint8_t b) {
     const std::size_t i = pos_++ - (4 + 2 + 7);
-    const std::size_t y = d_.ny, p = d_.np;
+    const std::size_t y = d_.ny;
     if (i < y) sensor_[i] = b;
-    else if (i < y + p) spring_a_[i - y] = b;
-    else spring_b_[i - y - p] = b;
+    else kind_[i - y] = b;
   }
   // The v-th value after the header, into its place.
   void put(std::size_t v, double x) {
@@ -173,28 +174,30 @@ class Estimator {
     else if (in(nx)) B0_[v - o] = s;
     else if (in(nx)) B1_[v - o] = s;
     else if (in(np * nx)) G_[(v - o) / nx][(v - o) % nx] = s;
+    else if (in(np * nx)) W_[(v - o) / nx][(v - o) % nx] = s;
     else if (in(nx * ny)) L_[(v - o) / ny][(v - o) % ny] = s;
     else if (in(nx * ny)) Lq_[(v - o) / ny][(v - o) % ny] = s;
     else if (in(ny * nx)) C_[(v - o) / nx][(v - o) % nx] = s;
     else if (in(ny * np)) H_[(v - o) / np][(v - o) % np] = s;
     else if (in(nx)) top_c_[v - o] = s;
     else if (in(np)) top_h_[v - o] = s;
-    else if (in(np)) cd_[v - o] = s;
+    else if (in(np)) prior_[v - o] = s;
+    else if (in(np)) cap_[v - o] = s;
     else var_[v - o] = s;
   }
   // The decoded image's indices and settings make sense for this node.
   const char* check() {
-    const int nq = d_.nq;
     for (int i = 0; i < d_.ny; ++i)
       if (sensor_[i] >= d_.stories) return "twin image: a sensor off the frame";
     for (int j = 0; j < d_.np; ++j)
-      if (spring_b_[j] >= nq || (spring_a_[j] != kNone8 && spring_a_[j] >= nq)) return "twin image: a spring off the frame";
+      if (kind_[j] > static_cast<std::uint8_t>(TwinParam::kMass) || !(prior_[j] > S(0)) || !(cap_[j] > S(0)))
+        return "twin image: a parameter's kind, prior or step out of range";
     if (d_.extra == TwinExtra::kForce && device_dof_ >= d_.stories) return "twin image: the device floor is off the frame";
     const double* c = set_;
-    if (!(c[kForget] > 0 && c[kForget] <= 1) || !(c[kPriorInfo] > 0) || !(c[kUpdateSteps] >= 1 && c[kUpdateSteps] <= 1e6) ||
+    if (!(c[kForget] > 0 && c[kForget] <= 1) || !(c[kUpdateSteps] >= 1 && c[kUpdateSteps] <= 1e6) ||
         !(c[kKappa] >= 0) || !(c[kLossMin] >= 0) || !(c[kDeviceLossMin] >= 0) || !(c[kHoldSteps] >= 0) ||
         !(c[kInnovAlpha] > 0 && c[kInnovAlpha] <= 1) || !(c[kLossLow] < 0 && c[kLossHigh] > 0 && c[kLossHigh] < 1) ||
-        !(c[kPeriod] > 0) || !(c[kMaxStep] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0))
+        !(c[kPeriod] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0))
       return "twin image: a setting out of range";
     for (int i = 0; i < d_.ny; ++i)
       if (!(var_[i] > S(0))) return "twin image: an innovation variance is not positive";
@@ -209,14 +212,10 @@ class Estimator {
     for (int i = 0; i < n; ++i) t += a[i] * b[i];
     return t;
   }
-  // Spring j's damage signal on state z: its drift and, with stiffness-
-  // proportional damping, c_d times its rate.
-  S w(int j, const S* z) const {
-    const int nq = d_.nq, a = spring_a_[j], b = spring_b_[j];
-    const S d = z[b] - (a == kNone8 ? S(0) : z[a]);
-    const S r = z[nq + b] - (a == kNone8 ? S(0) : z[nq + a]);
-    return d + cd_[j] * r;
-  }
+  // Parameter j's signal on state z: a spring's drift (with stiffness-
+  // proportional damping, plus c_d times its rate), a floor's absolute
+  // acceleration.
+  S w(int j, const S* z) const { return dot(W_[j], z, d_.nx); }
 
   // z <- z + dA z + B0 a0 + B1 a1 + sum_j G_j loss_j w_j(z); each sensitivity
   // s_j <- s_j + dA s_j + G_j w_j(z).
@@ -296,10 +295,9 @@ class Estimator {
   // Cholesky of J + prior (lower, in place of a copy); false if not positive.
   bool factor(S (&F)[kP][kP]) const {
     const int np = d_.np;
-    const S prior = static_cast<S>(set_[kPriorInfo]);
     for (int a = 0; a < np; ++a)
       for (int b = 0; b <= a; ++b) {
-        S t = J_[a][b] + (a == b ? prior : S(0));
+        S t = J_[a][b] + (a == b ? prior_[a] : S(0));
         for (int c = 0; c < b; ++c) t -= F[a][c] * F[b][c];
         if (a == b) {
           if (!(t > S(0))) return false;
@@ -326,12 +324,12 @@ class Estimator {
       for (int c = a + 1; c < np; ++c) t -= F[c][a] * u[c];
       u[a] = t / F[a][a];
     }
-    // A trust region: no loss moves by more than kMaxStep an update (the
+    // A trust region: no parameter moves by more than its cap an update (the
     // sensitivities are a linearisation; a long step on little information
     // lands where they no longer hold).
     const S lo = static_cast<S>(set_[kLossLow]), hi = static_cast<S>(set_[kLossHigh]);
-    const S cap = static_cast<S>(set_[kMaxStep]);
     for (int a = 0; a < np; ++a) {
+      const S cap = cap_[a];
       const S step = u[a] < -cap ? -cap : (u[a] > cap ? cap : u[a]);
       const S v = loss_[a] + step;
       loss_[a] = v < lo ? lo : (v > hi ? hi : v);
@@ -363,13 +361,14 @@ class Estimator {
   // The decision: a story whose loss is beyond kappa sd and the smallest
   // size, held for the hold time, raises the alarm (latched); the story
   // reported is the strongest candidate (largest loss over its threshold).
-  // The TMD's spring: the same on |loss| with its own size.
+  // The TMD's spring: the same on |loss| with its own size. Masses: none.
   void decide() {
     const S kappa = static_cast<S>(set_[kKappa]);
     int best = -1;
     S best_ratio(0);
     for (int j = 0; j < d_.np; ++j) {
-      const bool tmd = j >= d_.stories;
+      if (kind_[j] == static_cast<std::uint8_t>(TwinParam::kMass)) continue;
+      const bool tmd = kind_[j] == static_cast<std::uint8_t>(TwinParam::kDeviceSpring);
       const S size = tmd ? (loss_[j] < S(0) ? -loss_[j] : loss_[j]) : loss_[j];
       const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
       const S thr = kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
@@ -396,10 +395,10 @@ class Estimator {
   const char* failed_ = nullptr;
   bool ready_ = false;
   double set_[kTwinSettings] = {};
-  std::uint8_t sensor_[kY] = {}, spring_a_[kP] = {}, spring_b_[kP] = {};
-  S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, L_[kX][kY] = {}, Lq_[kX][kY] = {};
-  S C_[kY][kX] = {};
-  S H_[kY][kP] = {}, top_c_[kX] = {}, top_h_[kP] = {}, cd_[kP] = {}, var_[kY] = {};
+  std::uint8_t sensor_[kY] = {}, kind_[kP] = {};
+  S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, W_[kP][kX] = {};
+  S L_[kX][kY] = {}, Lq_[kX][kY] = {}, C_[kY][kX] = {};
+  S H_[kY][kP] = {}, top_c_[kX] = {}, top_h_[kP] = {}, prior_[kP] = {}, cap_[kP] = {}, var_[kY] = {};
   long update_steps_ = 1, hold_steps_ = 0;
   // state
   S z_[kX] = {}, s_[kP][kX] = {}, a_ = S(0);

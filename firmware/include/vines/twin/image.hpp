@@ -7,13 +7,14 @@
 // Layout, little-endian (wire.hpp):
 //   "VNTW", u16 version, u8 stories, u8 extra (TwinExtra), u8 ny, u8 np,
 //   u8 nx, u8 nq, u8 device_dof (255: none), u8 sensor_dof[ny],
-//   u8 spring_a[np] (255: ground), u8 spring_b[np],
+//   u8 kind[np] (TwinParam),
 //   f64 settings[kTwinSettings] (TwinSetting order),
-//   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], L[nx][ny], Lq[nx][ny],
-//   C[ny][nx], H[ny][np], top_c[nx], top_h[np], spring_cd[np],
-//   innovation_var[ny]
+//   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], W[np][nx], L[nx][ny],
+//   Lq[nx][ny], C[ny][nx], H[ny][np], top_c[nx], top_h[np],
+//   prior_info[np], step_cap[np], innovation_var[ny]
 // (L the gain with the device's force free, Lq with it held near zero: the
-// same but for a VI NES; innovation_var the quiet design's)
+// same but for a VI NES; W_j the state's row that parameter j's force is
+// proportional to; innovation_var the quiet design's)
 // (matrices row-major: dA = Phi - I, the discrete transition less identity;
 // see docs/twin.md for each).
 #pragma once
@@ -32,17 +33,23 @@ inline constexpr int kMaxSensors = 8;
 inline constexpr std::uint8_t kNone8 = 255;  // "ground" (a spring's end) or "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
-inline constexpr std::uint16_t kTwinVersion = 1;
+inline constexpr std::uint16_t kTwinVersion = 2;
 
 // The state beyond the frame's 2N: none (bare frame), the device's force on
 // its floor as an unknown input (VI NES: one state), or the TMD's own mass
 // (two states, its spring one more parameter).
 enum class TwinExtra : std::uint8_t { kNone = 0, kForce = 1, kTmd = 2 };
 
+// What a parameter p_j is: each scales its nominal by eta_j = 1 - p_j.
+enum class TwinParam : std::uint8_t {
+  kStory = 0,         // a story's stiffness (damage: p > 0 is a loss)
+  kDeviceSpring = 1,  // the TMD's spring
+  kMass = 2,          // the VI NES floor's mass: a sphere stuck on its floor adds its own
+};
+
 // Scalar settings of the estimator, in the image in this order.
 enum TwinSetting : int {
   kForget,        // information kept per step (exp(-h / memory))
-  kPriorInfo,     // prior information on each loss (1 / sd0^2)
   kUpdateSteps,   // steps between parameter updates
   kKappa,         // a loss is a candidate beyond kappa standard deviations...
   kLossMin,       // ...and beyond this size (stories)
@@ -53,7 +60,6 @@ enum TwinSetting : int {
   kLossLow,       // estimates clamped to [low, high]
   kLossHigh,
   kPeriod,        // h [s]
-  kMaxStep,       // largest change of a loss in one update
   kJumpSigma,     // an innovation beyond this many quiet sd: the impact gain...
   kJumpHold,      // ...for this many steps
   kTwinSettings
@@ -71,18 +77,18 @@ inline TwinDims twin_dims(int n, TwinExtra e, int ny) {
   d.extra = e;
   d.nq = n + (e == TwinExtra::kTmd ? 1 : 0);
   d.nx = 2 * d.nq + (e == TwinExtra::kForce ? 1 : 0);
-  d.np = n + (e == TwinExtra::kTmd ? 1 : 0);
+  d.np = n + (e == TwinExtra::kNone ? 0 : 1);  // stories, then the TMD's spring or the VI NES floor's mass
   d.ny = ny;
   return d;
 }
 
 // Bytes before the matrices, and the number of f64 values after them.
 inline std::size_t twin_header_bytes(const TwinDims& d) {
-  return 4 + 2 + 7 + static_cast<std::size_t>(d.ny) + 2 * static_cast<std::size_t>(d.np);
+  return 4 + 2 + 7 + static_cast<std::size_t>(d.ny) + static_cast<std::size_t>(d.np);
 }
 inline std::size_t twin_values(const TwinDims& d) {
   const std::size_t x = d.nx, p = d.np, y = d.ny;
-  return kTwinSettings + x * x + 2 * x + p * x + 3 * x * y + y * p + x + 2 * p + y;
+  return kTwinSettings + x * x + 2 * x + 2 * p * x + 3 * x * y + y * p + x + 3 * p + y;
 }
 inline bool is_twin_image(const std::uint8_t* p, std::size_t n) {
   return p != nullptr && n >= 4 && std::memcmp(p, kTwinMagic, 4) == 0;

@@ -1,0 +1,198 @@
+// The twin monitor with its estimator (docs/twin.md): the frame's state and
+// each story's stiffness kept on the measured floors, against truths that
+// are not the node's model (a lost story, a sphere started elsewhere, a
+// detuned TMD, a stuck sphere); the estimator in float against double on the
+// same image; bad inputs refused with the reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim_host/build_engine.hpp"
+#include "sim_host/hil.hpp"
+#include "sim_host/hil_twin.hpp"
+#include "sim_host/run.hpp"
+#include "vines/twin/estimator.hpp"
+
+namespace vines::host {
+namespace {
+
+std::string scene_path(const std::string& name) { return std::string(VINES_SOURCE_DIR) + "/data/scenes/" + name; }
+
+HilOptions twin(double duration_s, const std::string& truth = "") {
+  HilOptions o;
+  o.node_command = VINES_EXE;
+  o.mode = HilMode::kTwin;
+  o.duration_s = duration_s;
+  o.timeout_s = 20;
+  o.sensors = {3, 6, 8, 10};
+  o.measure_noise_pct = 5;
+  o.truth_path = truth.empty() ? "" : scene_path(truth);
+  return o;
+}
+
+HilTwinReport run_twin(const std::string& scene, const HilOptions& o) {
+  const HilReport r = run_hil(load_scene(scene_path(scene)), o);
+  EXPECT_TRUE(r.bit_exact);  // the host node: the offline estimator on the same readings, bit for bit
+  EXPECT_TRUE(r.twin.has_value());
+  return r.twin.value_or(HilTwinReport{});
+}
+
+// With a truth equal to the model and no noise, the filter holds the state
+// exactly and no parameter moves: the model and its discretisation are the
+// core's (the same frame, the same first-order hold of the ground).
+TEST(Twin, ExactModelHeldExactly) {
+  HilOptions o = twin(20.0);
+  o.measure_noise_pct = 0;
+  const HilTwinReport t = run_twin("elcentro_bare.toml", o);
+  ASSERT_TRUE(t.roof_displacement_nrmse);
+  EXPECT_LT(*t.roof_displacement_nrmse, 1e-9);
+  EXPECT_LT(t.residual_max_mps2, 1e-9);
+  for (double e : t.eta_k) EXPECT_NEAR(e, 1.0, 1e-6);
+  EXPECT_FALSE(t.detected);
+}
+
+// A 10 % loss in story 3 of the bare frame, 5 % noise on floors 3, 6, 8, 10:
+// found, in story 3, its size within 2 points, within 20 s of strong motion.
+TEST(Twin, FindsAStoryLossInTheBareFrame) {
+  HilOptions o = twin(30.0);
+  o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_bare_story3_loss10.toml";
+  const HilTwinReport t = run_twin("elcentro_bare.toml", o);
+  ASSERT_TRUE(t.detected);
+  ASSERT_TRUE(t.story && t.size && t.detect_delay_s);
+  EXPECT_EQ(*t.story, 3);
+  EXPECT_NEAR(*t.size, 0.10, 0.02);
+  EXPECT_LT(*t.detect_delay_s, 20.0);
+  EXPECT_NEAR(t.truth_story_scales[2], 0.9, 1e-12);
+}
+
+// The VI NES building, its sphere started elsewhere than the model's and
+// story 3 at 90 %: the impacts do not hide the loss; the roof is followed
+// within 5 % NRMSE; the impacts the force estimate shows are the truth's.
+TEST(Twin, VinesBuildingLossAndImpacts) {
+  const HilTwinReport t = run_twin("elcentro_vines.toml", twin(0, "twin/truth_story3_loss10.toml"));
+  ASSERT_TRUE(t.detected && t.story && t.size);
+  EXPECT_EQ(*t.story, 3);
+  EXPECT_NEAR(*t.size, 0.10, 0.02);
+  ASSERT_TRUE(t.roof_displacement_nrmse);
+  EXPECT_LT(*t.roof_displacement_nrmse, 0.05);
+  EXPECT_EQ(t.device.kind, "vines");
+  EXPECT_EQ(t.device.sphere, "moving");
+  EXPECT_NEAR(static_cast<double>(t.device.impacts_estimated), static_cast<double>(t.device.contacts_truth),
+              0.3 * static_cast<double>(t.device.contacts_truth));
+  EXPECT_LT(std::fabs(t.device.added_mass_ratio), 0.3);
+}
+
+// A jammed sphere moves with its floor: the floor's identified mass gains
+// most of the sphere's, and the sphere is reported stuck.
+TEST(Twin, StuckSphereReported) {
+  const HilTwinReport t = run_twin("elcentro_vines.toml", twin(0, "twin/truth_sphere_stuck.toml"));
+  EXPECT_EQ(t.device.sphere, "stuck");
+  EXPECT_GT(t.device.added_mass_ratio, 0.5);
+  EXPECT_EQ(t.device.contacts_truth, 0);
+}
+
+// A TMD 10 % low in frequency: its spring identified, the TMD reported
+// detuned, its frequency within 3 points of the truth's.
+TEST(Twin, DetunedTmdReported) {
+  const HilTwinReport t = run_twin("elcentro_tmd.toml", twin(0, "twin/truth_tmd_detuned.toml"));
+  EXPECT_EQ(t.device.kind, "tmd");
+  EXPECT_TRUE(t.device.detuned);
+  EXPECT_NEAR(t.device.truth_frequency_factor, 0.9, 1e-3);
+  EXPECT_NEAR(t.device.frequency_factor, 0.9, 0.03);
+}
+
+// The estimator in float (the Cortex-M4F's) on the same image and readings
+// as in double: the roof within 1e-4 of the double's peak, every factor
+// within 0.005, the same decision.
+TEST(Twin, FloatFollowsDouble) {
+  Scene sc = load_scene(scene_path("elcentro_vines.toml"));
+  sc.duration_s = 20;
+  HilOptions o = twin(20.0, "twin/truth_story3_loss10.toml");
+  const Excitation ex = load_excitation(sc, "");
+  const TwinBench tb = make_twin_bench(sc, o, ex);
+  auto f = std::make_unique<twin::Estimator<float, 10>>();
+  auto d = std::make_unique<twin::Estimator<double, 10>>();
+  f->image_begin(), d->image_begin();
+  ASSERT_EQ(f->image_push(tb.design.image.data(), tb.design.image.size()), nullptr);
+  ASSERT_EQ(d->image_push(tb.design.image.data(), tb.design.image.size()), nullptr);
+  ASSERT_EQ(f->image_finish(), nullptr);
+  ASSERT_EQ(d->image_finish(), nullptr);
+  double peak = 0, diff = 0;
+  for (std::size_t k = 0; k < ex.samples.size(); ++k) {
+    const int ny = static_cast<int>(tb.y[k].size());
+    if (k == 0) f->init(static_cast<float>(ex.samples[0]), tb.y[0].data(), ny), d->init(ex.samples[0], tb.y[0].data(), ny);
+    else f->step(static_cast<float>(ex.samples[k]), tb.y[k].data(), ny), d->step(ex.samples[k], tb.y[k].data(), ny);
+    peak = std::max(peak, std::fabs(d->x(9)));
+    diff = std::max(diff, std::fabs(static_cast<double>(f->x(9)) - d->x(9)));
+  }
+  EXPECT_LT(diff, 1e-4 * peak);
+  for (int j = 0; j < d->dims().np; ++j) EXPECT_NEAR(f->loss(j), d->loss(j), 0.005) << "parameter " << j;
+  EXPECT_EQ(f->alarm_story(), d->alarm_story());
+  EXPECT_EQ(d->alarm_story(), 3);
+}
+
+// A twin image damaged on its way is refused with the reason.
+TEST(Twin, DamagedImageRefused) {
+  Scene sc = load_scene(scene_path("elcentro_bare.toml"));
+  sc.duration_s = 1;
+  const TwinBench tb = make_twin_bench(sc, twin(1.0), load_excitation(sc, ""));
+  const std::vector<std::uint8_t>& good = tb.design.image;
+  auto refusal = [](std::vector<std::uint8_t> img) -> std::string {
+    auto e = std::make_unique<twin::Estimator<double, 10>>();
+    e->image_begin();
+    const char* why = e->image_push(img.data(), img.size());
+    if (!why) why = e->image_finish();
+    return why ? why : "";
+  };
+  EXPECT_EQ(refusal(good), "");
+  EXPECT_EQ(refusal(std::vector<std::uint8_t>(good.begin(), good.end() - 8)), "twin image: truncated");
+  std::vector<std::uint8_t> bad = good;
+  bad[0] = 'X';
+  EXPECT_EQ(refusal(bad), "twin image: not a twin image");
+  bad = good;
+  for (int i = 0; i < 8; ++i) bad[bad.size() - 8 + i] = 0xff;  // a NaN
+  EXPECT_EQ(refusal(bad), "twin image: a value is not finite");
+  bad = good;
+  bad.push_back(0);
+  EXPECT_NE(refusal(bad), "");
+}
+
+// Bad twin inputs: each refused, naming the input.
+TEST(Twin, BadInputsRefused) {
+  const Scene sc = load_scene(scene_path("elcentro_bare.toml"));
+  auto refused = [&](HilOptions o, const std::string& what) {
+    try {
+      run_hil(sc, o);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  HilOptions o = twin(1.0);
+  o.sensors = {0, 3};
+  refused(o, "--sensors 0: a floor from 1 to 10");
+  o.sensors = {11};
+  refused(o, "--sensors 11: a floor from 1 to 10");
+  o.sensors = {3, 3};
+  refused(o, "--sensors 3: given twice");
+  o.sensors = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  refused(o, "--sensors: at most 8 floors");
+  o = twin(1.0);
+  o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_truth_3_stories.toml";
+  refused(o, "frame.stories 3 differs");
+  o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_truth_kobe.toml";
+  refused(o, "its record (file, scale or pga) differs");
+  o = twin(1.0);
+  o.measure_noise_mps2 = 0.1;
+  refused(o, "--measure-noise and --measure-noise-pct: give one of them");
+  HilOptions replay;
+  replay.node_command = VINES_EXE;
+  replay.sensors = {3};
+  refused(replay, "--sensors: a twin option");
+}
+
+}  // namespace
+}  // namespace vines::host
