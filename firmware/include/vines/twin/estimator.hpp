@@ -328,11 +328,19 @@ class Estimator {
     // sensitivities are a linearisation; a long step on little information
     // lands where they no longer hold).
     const S lo = static_cast<S>(set_[kLossLow]), hi = static_cast<S>(set_[kLossHigh]);
+    // The state moves with the parameters, to first order (the posterior
+    // sensitivities): as if they had always had their new values. Without
+    // it the state keeps the old values' error for the filter's memory, the
+    // innovations keep asking for the same correction, and the steps
+    // overshoot.
+    const int nx = d_.nx;
     for (int a = 0; a < np; ++a) {
       const S cap = cap_[a];
       const S step = u[a] < -cap ? -cap : (u[a] > cap ? cap : u[a]);
       const S v = loss_[a] + step;
-      loss_[a] = v < lo ? lo : (v > hi ? hi : v);
+      const S next = v < lo ? lo : (v > hi ? hi : v);
+      for (int i = 0; i < nx; ++i) z_[i] += s_[a][i] * (next - loss_[a]);
+      loss_[a] = next;
       g_[a] = S(0);
     }
     sds(F);
@@ -362,17 +370,26 @@ class Estimator {
   // size, held for the hold time, raises the alarm (latched); the story
   // reported is the strongest candidate (largest loss over its threshold).
   // The TMD's spring: the same on |loss| with its own size. Masses: none.
+  // A plausibility gate: a story that gained stiffness beyond the same
+  // threshold is no damage but an estimate the data do not support (a
+  // narrow-band record exciting one mode, a model error); while one does, no
+  // story is a candidate.
   void decide() {
     const S kappa = static_cast<S>(set_[kKappa]);
+    auto threshold = [&](int j, bool tmd) {
+      const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
+      return kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
+    };
+    bool plausible = true;
+    for (int j = 0; j < d_.stories; ++j) plausible = plausible && -loss_[j] <= threshold(j, false);
     int best = -1;
     S best_ratio(0);
     for (int j = 0; j < d_.np; ++j) {
       if (kind_[j] == static_cast<std::uint8_t>(TwinParam::kMass)) continue;
       const bool tmd = kind_[j] == static_cast<std::uint8_t>(TwinParam::kDeviceSpring);
       const S size = tmd ? (loss_[j] < S(0) ? -loss_[j] : loss_[j]) : loss_[j];
-      const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
-      const S thr = kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
-      const bool candidate = size > thr;
+      const S thr = threshold(j, tmd);
+      const bool candidate = size > thr && (tmd || plausible);
       held_[j] = candidate ? held_[j] + update_steps_ : 0;
       if (tmd) {
         if (held_[j] >= hold_steps_) device_alarm_ = true;
