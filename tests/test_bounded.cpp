@@ -298,9 +298,10 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   ASSERT_TRUE(link::decode(blob, n, &d));
   EXPECT_EQ(d.scene.loop.contact_scheme, ContactScheme::kBounded);
   EXPECT_EQ(d.scene.loop.bounded_substeps, 11);
-  // The scheme and budget bytes, before the deadline budget (u32) and the
-  // hybrid compensator's kind (u8) and window (f64), the last fields.
-  constexpr std::size_t kTail = 4 + 1 + 8;
+  // The scheme and budget bytes, before the deadline budget (u32), the
+  // hybrid compensator's kind (u8) and window (f64) and the twin's estimator
+  // (u8), the last fields.
+  constexpr std::size_t kTail = 4 + 1 + 8 + 1;
   const std::size_t at_scheme = n - kTail - 2, at_budget = n - kTail - 1;
   EXPECT_EQ(blob[at_scheme], 1);
   EXPECT_EQ(blob[at_budget], 11);

@@ -56,6 +56,11 @@ path = "a"
   expect_refused("[device]\nkind = \"tmd\"\nmass_kg = -3\n[record]\npath = \"a\"\n",
                  {"bad.toml:3:", "device.mass_kg", "> 0"});
   expect_refused(kBase + "[frame]\nstiffness_scale = -1\n", {"frame.stiffness_scale"});
+  // One factor per story (Table 1: 10), each in (0, 10].
+  expect_refused(kBase + "[frame]\nstiffness_scales = [1, 0.9]\n",
+                 {"frame.stiffness_scales", "one factor per story (10)"});
+  expect_refused(kBase + "[frame]\nstiffness_scales = [1, 1, 0, 1, 1, 1, 1, 1, 1, 1]\n",
+                 {"frame.stiffness_scales[2]", "(0, 10]"});
 }
 
 TEST(SceneError, VinesValues) {

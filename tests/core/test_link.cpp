@@ -183,7 +183,16 @@ TEST(Messages, RoundTripBitForBit) {
   EXPECT_TRUE(std::isnan(s2.aux));
   EXPECT_EQ(s2.table_x, s.table_x);
   std::uint8_t sample_payload[kMaxPayload];
-  EXPECT_EQ(encode(s, sample_payload, sizeof sample_payload), 4u + 8 + 8 + 8 + 8);  // k, t_ns, ag, aux, table_x
+  EXPECT_EQ(encode(s, sample_payload, sizeof sample_payload), 4u + 8 + 8 + 8 + 8 + 1);  // k, t_ns, ag, aux, table_x, ny
+  // The twin's measured floors: as many as ny says, at most kMaxSensors.
+  s.ny = 3;
+  for (int i = 0; i < 3; ++i) s.y[i] = -0.5 + i;
+  const Sample s3 = round_trip(s);
+  EXPECT_EQ(s3.ny, 3);
+  EXPECT_EQ(std::memcmp(s3.y, s.y, 3 * sizeof(double)), 0);
+  EXPECT_EQ(encode(s, sample_payload, sizeof sample_payload), 4u + 8 + 8 + 8 + 8 + 1 + 3 * 8);
+  s.ny = twin::kMaxSensors + 1;
+  EXPECT_EQ(encode(s, sample_payload, sizeof sample_payload), 0u);
 
   Telemetry t;
   t.rx = 9;
@@ -195,7 +204,12 @@ TEST(Messages, RoundTripBitForBit) {
   t.dissipated = 5.5;
   t.drift_alarms = 1ull << 39;
   t.comp[0] = 1.01, t.comp[1] = 0.0166, t.comp[2] = 1.4e-4;
+  t.est_index = 40, t.alarm_story = 3, t.est_eta = 0.9, t.est_sd = 0.01;
   const Telemetry t2 = round_trip(t);
+  EXPECT_EQ(t2.est_index, 40);
+  EXPECT_EQ(t2.alarm_story, 3);
+  EXPECT_EQ(t2.est_eta, 0.9);
+  EXPECT_EQ(t2.est_sd, 0.01);
   EXPECT_EQ(std::memcmp(t2.comp, t.comp, sizeof t.comp), 0);
   EXPECT_EQ(std::memcmp(t2.x, t.x, sizeof t.x), 0);
   EXPECT_EQ(t2.acc_top, t.acc_top);
@@ -228,6 +242,7 @@ TEST(Config, RoundTripsEveryField) {
   for (int i = 0; i < 3; ++i) c.scene.frame.mass_kg[i] = 1e5 + i, c.scene.frame.stiffness_n_per_m[i] = 5e7 - i;
   c.scene.frame.damping = DampingRule::kRayleigh;
   c.scene.frame.stiffness_scale = 0.8;
+  c.scene.frame.stiffness_scales[1] = 0.9;
   c.scene.device.kind = DeviceKind::kVines;
   c.scene.device.vines.law = ContactLaw::kTsuji;
   c.scene.device.vines.beta = 1.7;
@@ -239,6 +254,7 @@ TEST(Config, RoundTripsEveryField) {
   c.comp_order = 3;
   c.comp_kind = CompKind::kAdaptive;
   c.comp_window_s = 0.7;
+  c.estimator = TwinEstimator::kKalman;
   std::uint8_t blob[kMaxConfigBlob];
   const std::size_t n = encode(c, blob, sizeof blob);
   ASSERT_GT(n, 0u);
@@ -253,7 +269,15 @@ TEST(Config, RoundTripsEveryField) {
   EXPECT_EQ(d.drift_limit_m[2], 0.02);
   EXPECT_EQ(d.comp_kind, CompKind::kAdaptive);
   EXPECT_EQ(d.comp_window_s, 0.7);
+  EXPECT_EQ(d.scene.frame.stiffness_scales[1], 0.9);
+  EXPECT_EQ(d.estimator, TwinEstimator::kKalman);
   EXPECT_EQ(validate_node(d), nullptr);
+  NodeConfig replay = d;
+  replay.mode = NodeMode::kReplay;  // an estimator outside twin mode
+  EXPECT_STREQ(validate_node(replay), "estimator: only in twin mode");
+  blob[n - 1] = 2;  // no such estimator
+  EXPECT_FALSE(decode(blob, n, &d));
+  blob[n - 1] = 1;
   EXPECT_FALSE(decode(blob, n - 1, &d));
   blob[0] = 41;  // stories out of range
   EXPECT_FALSE(decode(blob, n, &d));
