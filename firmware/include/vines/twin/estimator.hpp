@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "vines/twin/image.hpp"
 
@@ -62,7 +63,6 @@ class Estimator {
       for (int i = 0; i < kP; ++i) J_[j][i] = S(0);
     }
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
-    k_ = 0;
     since_ = 0;
     impact_left_ = 0;
     story_ = -1;
@@ -77,7 +77,6 @@ class Estimator {
   void step(S a1, const double* y, int ny) {
     predict(a1);
     update(y, ny);
-    ++k_;
     if (++since_ >= update_steps_) {
       since_ = 0;
       solve();
@@ -370,18 +369,18 @@ class Estimator {
   // size, held for the hold time, raises the alarm (latched); the story
   // reported is the strongest candidate (largest loss over its threshold).
   // The TMD's spring: the same on |loss| with its own size. Masses: none.
-  // A plausibility gate: a story that gained stiffness beyond the same
-  // threshold is no damage but an estimate the data do not support (a
-  // narrow-band record exciting one mode, a model error); while one does, no
-  // story is a candidate.
+  // A plausibility gate: a story does not gain stiffness in an earthquake,
+  // so a story whose estimated gain is at least a candidate's loss says the
+  // data do not support the split of the estimates (a narrow-band record
+  // exciting one mode, a model error): the candidate waits.
   void decide() {
     const S kappa = static_cast<S>(set_[kKappa]);
     auto threshold = [&](int j, bool tmd) {
       const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
       return kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
     };
-    bool plausible = true;
-    for (int j = 0; j < d_.stories; ++j) plausible = plausible && -loss_[j] <= threshold(j, false);
+    S gain(0);
+    for (int j = 0; j < d_.stories; ++j) gain = -loss_[j] > gain ? -loss_[j] : gain;
     int best = -1;
     S best_ratio(0);
     for (int j = 0; j < d_.np; ++j) {
@@ -389,7 +388,7 @@ class Estimator {
       const bool tmd = kind_[j] == static_cast<std::uint8_t>(TwinParam::kDeviceSpring);
       const S size = tmd ? (loss_[j] < S(0) ? -loss_[j] : loss_[j]) : loss_[j];
       const S thr = threshold(j, tmd);
-      const bool candidate = size > thr && (tmd || plausible);
+      const bool candidate = size > thr && (tmd || size > gain);
       held_[j] = candidate ? held_[j] + update_steps_ : 0;
       if (tmd) {
         if (held_[j] >= hold_steps_) device_alarm_ = true;
@@ -422,7 +421,7 @@ class Estimator {
   S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
   S r2_[kY] = {}, eps_[kY] = {};
   long held_[kP] = {};
-  long k_ = 0, since_ = 0, impact_left_ = 0;
+  long since_ = 0, impact_left_ = 0;
   int story_ = -1;
   bool detected_ = false, device_alarm_ = false;
 };

@@ -30,7 +30,7 @@ namespace vines::twin {
 
 // Floor accelerometers a twin node reads at most.
 inline constexpr int kMaxSensors = 8;
-inline constexpr std::uint8_t kNone8 = 255;  // "ground" (a spring's end) or "no device DOF"
+inline constexpr std::uint8_t kNone8 = 255;  // "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
 inline constexpr std::uint16_t kTwinVersion = 2;
