@@ -46,7 +46,7 @@ def report(target, jobs, images, a):
     runs = [j for j in jobs if j["target"] == target]
     modes = {}
     for mode in (a.schemes or ["default"]):
-        mine = [r for r in runs if r["device"] == "vines" and r["scheme"] == mode]
+        mine = [r for r in runs if r["device"] == "vines" and r["scheme"] == mode and r["kind"] not in TWIN_KINDS]
         if mine:
             modes[mode] = figures(mine, images[(target, "vines")], clock, "scene")
     rep = {"target": target, "board": board, "scalar": scalar, "sensor_rate_hz": rate, "clock_hz": clock,
