@@ -143,11 +143,11 @@ Discrete discretise(const Continuous& c, double h) {
 // The filter's Riccati equation P = A P A' - A P C' (C P C' + R)^-1 C P A' + Q
 // by the structure-preserving doubling algorithm (Chu, Fan and Lin 2005) on
 // its dual; the prior covariance P. Throws if it does not converge.
-Mat riccati(const Mat& A, const Mat& Cm, const Mat& Q, const Mat& R, int* iterations) {
+Mat riccati(const Mat& A, const Mat& Cm, const Mat& Q, const Mat& R) {
   const int n = static_cast<int>(A.rows());
   const Mat I = Mat::Identity(n, n);
   Mat Ak = A.transpose(), Gk = Cm.transpose() * R.inverse() * Cm, Hk = Q;
-  for (int it = 1; it <= 200; ++it) {
+  for (int it = 0; it < 200; ++it) {
     const Eigen::PartialPivLU<Mat> w(I + Gk * Hk);
     const Mat wA = w.solve(Ak), wG = w.solve(Gk);
     const Mat Hn = Hk + Ak.transpose() * Hk * wA;
@@ -156,10 +156,7 @@ Mat riccati(const Mat& A, const Mat& Cm, const Mat& Q, const Mat& R, int* iterat
     const double change = (Hn - Hk).norm(), size = Hn.norm();
     Hk = 0.5 * (Hn + Hn.transpose());
     if (!std::isfinite(size)) break;
-    if (change <= 1e-13 * size) {
-      *iterations = it;
-      return Hk;
-    }
+    if (change <= 1e-13 * size) return Hk;
   }
   throw std::runtime_error("the twin's Kalman gain: the Riccati equation did not converge");
 }
@@ -192,11 +189,10 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   TwinDesign out;
   // Two gains for a VI NES: the force free (impacts) and held near zero
   // (flight, most of the time); one otherwise.
-  const Mat P = riccati(z.Phi, Cm, Q, R, &out.riccati_iterations);
+  const Mat P = riccati(z.Phi, Cm, Q, R);
   Mat Qq = Q;
   if (d.extra == TwinExtra::kForce) Qq(2 * nq, 2 * nq) *= t.quiet_force_share * t.quiet_force_share;
-  int quiet_iterations = 0;
-  const Mat Pq = d.extra == TwinExtra::kForce ? riccati(z.Phi, Cm, Qq, R, &quiet_iterations) : P;
+  const Mat Pq = d.extra == TwinExtra::kForce ? riccati(z.Phi, Cm, Qq, R) : P;
   const Mat L = P * Cm.transpose() * (Cm * P * Cm.transpose() + R).inverse();
   const Mat S = Cm * Pq * Cm.transpose() + R;
   const Mat Lq = Pq * Cm.transpose() * S.inverse();

@@ -38,7 +38,6 @@ struct TwinDesign {
   std::vector<std::uint8_t> image;
   std::vector<double> innovation_sd;  // steady-state innovation sd per sensor [m/s^2]
   double roof_sd_m = 0;               // steady-state posterior sd of the roof displacement [m]
-  int riccati_iterations = 0;
 };
 
 // sensors: 1-based floors; noise_sd: each sensor's noise [m/s^2 RMS];
