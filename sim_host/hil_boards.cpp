@@ -27,13 +27,16 @@ const Board* board_of(const std::string& node) {
 std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) {
   std::string dev;
   const DeviceParams& d = sc.params.device;
-  if (d.kind == DeviceKind::kNone) dev = "none";
+  if (opt.mode == HilMode::kTwin && opt.estimator == HilEstimator::kKalman) dev = "twin";
+  else if (d.kind == DeviceKind::kNone) dev = "none";
   else if (d.kind == DeviceKind::kTmd) dev = "tmd";
   else if (d.vines.law == ContactLaw::kKuwabara) dev = "vines";
   else
     throw std::runtime_error(sc.path + ": --node " + opt.node +
                              ": the board images run the bare frame, the TMD and the VI NES with the Kuwabara law");
-  if (sc.params.frame.stories != 10)
+  if (dev == "twin" && sc.params.frame.stories > 10)
+    throw std::runtime_error(sc.path + ": --node " + opt.node + ": the twin image holds up to 10 stories");
+  if (dev != "twin" && sc.params.frame.stories != 10)
     throw std::runtime_error(sc.path + ": --node " + opt.node + ": the board images are built for 10 stories");
   const std::string path = !opt.image.empty() ? opt.image
                                               : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +

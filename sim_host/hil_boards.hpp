@@ -25,8 +25,8 @@ inline constexpr double kInstructionsPerTick = 40.0 / (1 << kIcountShift);
 // The board "qemu:TARGET" names, or nullptr.
 const Board* board_of(const std::string& node);
 
-// The board image for a scene's device (firmware/app: one per device):
-// opt.image, or the preset build's. Throws naming the scene or the node.
+// The board image for a scene's device (firmware/app: one per device; the
+// twin estimator's, whatever the device): opt.image, or the preset build's. Throws naming the scene or the node.
 std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc);
 
 // The QEMU command line that runs a board image.

@@ -97,8 +97,8 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     twin_->image_begin();
     const char* why = twin_->image_push(image_.data(), image_.size());
     if (!why) why = twin_->image_finish();
-    if (!why) why = twin_->check(c);
-    if (why) twin_.reset();
+    if (!why && twin_->configure(c, msg, cap)) return true;
+    twin_.reset();
     return !why || refuse(why);
   }
   const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;

@@ -14,6 +14,8 @@
 #include "sim_host/hil.hpp"
 #include "sim_host/hil_twin.hpp"
 #include "sim_host/run.hpp"
+#include "vines/link/model_plant.hpp"
+#include "vines/link/twin_plant.hpp"
 #include "vines/twin/estimator.hpp"
 
 namespace vines::host {
@@ -158,6 +160,40 @@ TEST(Twin, DamagedImageRefused) {
   bad = good;
   bad.push_back(0);
   EXPECT_NE(refusal(bad), "");
+}
+
+// The boards' twin image runs the estimator alone, and the device images
+// hold none: each refuses the other's work with the reason.
+TEST(Twin, TwinImageAndDeviceImagesKeepToTheirWork) {
+  Scene sc = load_scene(scene_path("elcentro_vines.toml"));
+  sc.duration_s = 1;
+  const TwinBench tb = make_twin_bench(sc, twin(1.0), load_excitation(sc, ""));
+  const std::vector<std::uint8_t>& img = tb.design.image;
+  link::NodeConfig c;
+  c.scene = sc.params;
+  c.mode = link::NodeMode::kTwin;
+  c.estimator = link::TwinEstimator::kKalman;
+  char msg[128] = "";
+
+  auto node = std::make_unique<link::TwinPlant<double, 10>>();
+  ASSERT_EQ(node->image_begin(static_cast<std::uint32_t>(img.size())), nullptr);
+  ASSERT_EQ(node->image_push(img.data(), img.size()), nullptr);
+  ASSERT_EQ(node->image_finish(), nullptr);
+  EXPECT_TRUE(node->configure(c, msg, sizeof msg)) << msg;
+  link::NodeConfig replay = c;
+  replay.mode = link::NodeMode::kReplay;
+  replay.estimator = link::TwinEstimator::kNone;
+  EXPECT_FALSE(node->configure(replay, msg, sizeof msg));
+  EXPECT_STREQ(msg, "mode: this node runs the twin estimator only (--mode twin --estimator kalman)");
+
+  using Kuwabara = VinesDevice<ContactLaw::kKuwabara>;
+  auto model = std::make_unique<Model<double, 10, Kuwabara>>();
+  auto data = std::make_unique<Data<double, 10, Kuwabara>>();
+  auto board = std::make_unique<link::ModelPlant<double, 10, Kuwabara>>(model.get(), data.get());
+  ASSERT_EQ(board->image_begin(static_cast<std::uint32_t>(img.size())), nullptr);
+  const char* why = board->image_push(img.data(), img.size());
+  ASSERT_NE(why, nullptr);
+  EXPECT_NE(std::string(why).find("holds no estimator"), std::string::npos) << why;
 }
 
 // Bad twin inputs: each refused, naming the input.

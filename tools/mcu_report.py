@@ -29,8 +29,8 @@ mode (contact scheme), the VI NES runs are:
            scene run; gap read from `VINES run`'s summary of the scene);
 and once per target, not per mode: the TMD scene (elcentro_tmd.toml) and the
 bare frame (elcentro_bare.toml) at the target's rate. The twin node (docs/twin.md;
-kinds twin_vines, twin_tmd, twin_bare): each device's image in twin mode
-with the estimator, El Centro at 1 kHz, floors 3, 6, 8, 10 measured with
+kinds twin_vines, twin_tmd, twin_bare): the twin image with the estimator,
+each device's building, El Centro at 1 kHz, floors 3, 6, 8, 10 measured with
 5 % noise (vines hil --mode twin --sensors 3,6,8,10 --measure-noise-pct 5). --only limits the
 kinds. --quick: the scene only, 3 s (or --duration). --duration S caps every
 run (vines hil --duration), except the scene run with --full-scene.
@@ -81,7 +81,7 @@ Exit status 0 if every run succeeded, 1 if a run failed (the others are
 still reported) or on a user error (missing vines or image: says what to
 build). Interrupted (Ctrl-C), it waits for the runs under way and reports
 the finished ones (status 130). Needs: the presets cortex-m4f / cortex-m7 built (images
-build/TARGET/firmware/app/vines_node_{none,tmd,vines}.elf), a host build of
+build/TARGET/firmware/app/vines_node_{none,tmd,vines,twin}.elf), a host build of
 vines, qemu-system-arm, arm-none-eabi-size and -nm. Standard library only.
 """
 import argparse
@@ -164,7 +164,7 @@ def main():
                                     f"cmake --build --preset {t})" for t, p in missing))
         images = {}
         for t in a.targets:
-            for d in sorted({j["device"] for j in jobs if j["target"] == t}):
+            for d in sorted({j["image"] for j in jobs if j["target"] == t}):
                 images[(t, d)] = image_info(t, d)
         print(f"mcu_report: {len(jobs)} runs, {a.jobs} at once", file=sys.stderr, flush=True)
         complete = run_all(a.vines, jobs, a.jobs)

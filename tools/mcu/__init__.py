@@ -13,10 +13,11 @@ TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate 
     "cortex-m7": ("mps2-an500", "double", 2048.0, 480e6),
 }
 MARGIN = 1.5  # the step must fit in 2/3 of the period
-DEVICES = ("none", "tmd", "vines")
+IMAGES = ("none", "tmd", "vines", "twin")  # vines_node_IMAGE.elf: a device's, or the twin estimator's
 KINDS = ("scene", "records", "ics", "tmd", "bare", "twin_vines", "twin_tmd", "twin_bare")
-# The twin node (docs/twin.md) on each device's image: El Centro at 1 kHz,
-# floors 3, 6, 8, 10 measured with 5 % noise; kind -> (device, scene).
+# The twin node (docs/twin.md) on the twin image, for each device's building:
+# El Centro at 1 kHz, floors 3, 6, 8, 10 measured with 5 % noise;
+# kind -> (device, scene).
 TWIN_KINDS = {"twin_vines": ("vines", "elcentro_vines.toml"), "twin_tmd": ("tmd", "elcentro_tmd.toml"),
               "twin_bare": ("none", "elcentro_bare.toml")}
 TWIN_ARGS = ["--mode", "twin", "--sensors", "3,6,8,10", "--measure-noise-pct", "5"]

@@ -3,7 +3,7 @@ TMD and bare-frame runs (worst and median step, sustained rate, flash, RAM,
 stack), the images and every run, as the JSON object of --json or as text."""
 import re
 
-from . import DEVICES, MARGIN, QUICK_DURATION_S, TARGETS, TWIN_KINDS
+from . import IMAGES, MARGIN, QUICK_DURATION_S, TARGETS, TWIN_KINDS
 
 
 # The figures of one group of runs on one image (a mode's VI NES runs, or the TMD or
@@ -53,19 +53,19 @@ def report(target, jobs, images, a):
            "margin": MARGIN, "instructions_per_cycle_assumed": 1,
            "duration_cap_s": a.duration if a.duration else (QUICK_DURATION_S if a.quick else None),
            "full_scene": a.full_scene,
-           "images": {d: images[(target, d)] for d in DEVICES if (target, d) in images},
+           "images": {d: images[(target, d)] for d in IMAGES if (target, d) in images},
            "modes": modes}
-    for kind, dev in (("tmd", "tmd"), ("bare", "none")) + tuple((k, d) for k, (d, _) in TWIN_KINDS.items()):
+    for kind, dev in (("tmd", "tmd"), ("bare", "none")) + tuple((k, "twin") for k in TWIN_KINDS):
         mine = [r for r in runs if r["kind"] == kind]
         if mine:
             rep[kind] = figures(mine, images[(target, dev)], clock, kind)
-    keep = ("kind", "device", "scheme", "record", "ic", "initial_position_m", "initial_velocity_mps",
+    keep = ("kind", "device", "image", "scheme", "record", "ic", "initial_position_m", "initial_velocity_mps",
             "duration_cap_s", "steps", "samples", "worst", "worst_k", "median", "overruns", "stack_peak_bytes",
             "max_deviation_from_offline", "outputs_finite", "wall_time_s", "tool_wall_time_s", "odd", "error")
     rep["runs"] = [{k: r[k] for k in keep if k in r} for r in runs]
     for r, out in zip(runs, rep["runs"]):
         # A build during the report: the run's image is not the one sized.
-        sized = images[(target, r["device"])]["sha256"]
+        sized = images[(target, r["image"])]["sha256"]
         if r.get("image_sha256") and r["image_sha256"] != sized:
             out["image_sha256"] = r["image_sha256"]
             out.setdefault("odd", []).append(f"image {r['image_sha256']}, not the one sized ({sized})")
@@ -105,8 +105,8 @@ def print_text(rep):
           + ")")
     for mode, f in rep["modes"].items():
         print("\n".join(fmt_block(f"VI NES, mode {mode}", f, rep["clock_hz"])))
-    for kind, label in (("tmd", "TMD"), ("bare", "bare frame"), ("twin_vines", "twin node, VI NES image"),
-                        ("twin_tmd", "twin node, TMD image"), ("twin_bare", "twin node, bare-frame image")):
+    for kind, label in (("tmd", "TMD"), ("bare", "bare frame"), ("twin_vines", "twin node, VI NES building"),
+                        ("twin_tmd", "twin node, TMD building"), ("twin_bare", "twin node, bare frame")):
         if kind in rep:
             print("\n".join(fmt_block(label, rep[kind], rep["clock_hz"])))
     for d, im in rep["images"].items():

@@ -32,6 +32,7 @@ def plan(a, tmp, records_dir):
         job = {"target": target, "scheme": mode or "default", "kind": kind,
                "device": scene.get("device", {}).get("kind", "none"), "record": record, "ic": ic,
                "scene_file": path, "duration_cap_s": run_cap}
+        job["image"] = job["device"]
         job.update(extra or {})
         jobs.append(job)
 
@@ -59,13 +60,13 @@ def plan(a, tmp, records_dir):
                 sc = base_scene(name, target, records_dir)
                 sc["loop"]["sensor_rate_hz"] = sc["output"]["rate_hz"] = TWIN_RATE_HZ
                 add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap,
-                    {"hil_args": TWIN_ARGS})
+                    {"hil_args": TWIN_ARGS, "image": "twin"})
     return jobs
 
 
-# The board image of a run: its preset's build of the run's device.
+# The board image of a run: its preset's build of the run's device's image (or the twin's).
 def image_for(job):
-    return os.path.join(ROOT, "build", job["target"], "firmware", "app", f"vines_node_{job['device']}.elf")
+    return os.path.join(ROOT, "build", job["target"], "firmware", "app", f"vines_node_{job['image']}.elf")
 
 
 # One `vines hil` run of the board in QEMU: the figures of its JSON report, or its error;

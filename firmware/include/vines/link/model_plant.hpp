@@ -1,10 +1,10 @@
 // The plant of a board's node (link/node.hpp): one compiled instance of the
 // core (scalar S, N stories, device Dev) whose model arrives as the image the
 // host built (model_image.hpp), decoded straight into static storage, for
-// replay and twin modes; in hybrid mode the bare frame driven by the table's
-// force (link/hybrid_frame.hpp), whose discretised modes arrive as the hybrid
-// frame image instead; in twin mode with an estimator the twin estimator
-// (twin_plant.hpp), whose design arrives as the twin image. The board never
+// replay mode and the open-loop twin; in hybrid mode the bare frame driven by
+// the table's force (link/hybrid_frame.hpp), whose discretised modes arrive
+// as the hybrid frame image instead. The twin with an estimator is another
+// image's (twin_plant.hpp, firmware/app/twin_main.cpp). The board never
 // builds a model: no eigensolver, no matrix exponential.
 #pragma once
 
@@ -16,8 +16,8 @@
 #include "vines/link/config.hpp"
 #include "vines/link/hybrid_frame.hpp"
 #include "vines/link/messages.hpp"
-#include "vines/link/twin_plant.hpp"
 #include "vines/model_image.hpp"
+#include "vines/twin/image.hpp"
 #include "vines/sim.hpp"
 
 namespace vines::link {
@@ -31,13 +31,11 @@ class ModelPlant {
   // model and data: static storage of the application (they are large).
   ModelPlant(ModelT* model, DataT* data) : model_(model), data_(data), loader_(model) {}
 
-  // The image: a core model image, streamed into the model; a twin image
-  // (told by its magic), streamed into the estimator; or a hybrid frame image
-  // (told by its magic), gathered and then loaded.
+  // The image: a core model image, streamed into the model, or a hybrid
+  // frame image (told by its magic), gathered and then loaded.
   const char* image_begin(std::uint32_t total) {
     configured_ = false;
     hybrid_ready_ = false;
-    twin_ready_ = false;
     loader_.reset();
     image_total_ = total;
     image_len_ = 0;
@@ -46,12 +44,7 @@ class ModelPlant {
   const char* image_push(const std::uint8_t* p, std::size_t n) {
     if (image_len_ == 0) {
       hybrid_image_ = is_hybrid_image(p, n);
-      twin_image_ = twin::is_twin_image(p, n);
-      if (twin_image_) twin_.image_begin();
-    }
-    if (twin_image_) {
-      image_len_ += n;
-      return twin_.image_push(p, n);
+      if (twin::is_twin_image(p, n)) return kNoEstimator;
     }
     if (!hybrid_image_) {
       image_len_ += n;
@@ -64,11 +57,6 @@ class ModelPlant {
     return nullptr;
   }
   const char* image_finish() {
-    if (twin_image_) {
-      const char* why = twin_.image_finish();
-      twin_ready_ = why == nullptr;
-      return why;
-    }
     if (!hybrid_image_) return loader_.finish();
     const char* why = hybrid_.load(hybrid_buf_, image_len_, N);
     hybrid_ready_ = why == nullptr;
@@ -85,28 +73,24 @@ class ModelPlant {
     }
     configured_ = true;
     hybrid_mode_ = c.mode == NodeMode::kHybrid;
-    twin_mode_ = c.mode == NodeMode::kTwin && c.estimator == TwinEstimator::kKalman;
     guard_events_ = 0;
     return true;
   }
 
-  void sense(const double* y, int ny) { twin_.sense(y, ny); }
+  void sense(const double*, int) {}  // the open-loop twin reads no floor
   void init(double a0, double f0) {
     guard_events_ = 0;
-    if (twin_mode_) twin_.init(a0);
-    else if (hybrid_mode_) hybrid_.init(a0, f0);
+    if (hybrid_mode_) hybrid_.init(a0, f0);
     else vines::init(*model_, *data_, static_cast<S>(a0));
   }
   void step(double a1, double f1) {
-    if (twin_mode_) twin_.step(a1);
-    else if (hybrid_mode_) hybrid_.step(a1, f1);
+    if (hybrid_mode_) hybrid_.step(a1, f1);
     else vines::step(*model_, *data_, static_cast<S>(a1));
   }
 
   // What the host node's plant reads (sim_host/hil_plant.cpp), from the same
   // core functions.
   void read(Telemetry* t) {
-    if (twin_mode_) return twin_.read(t);
     if (hybrid_mode_) {
       t->n = static_cast<std::uint8_t>(N);
       for (int i = 0; i < N; ++i) t->x[i] = hybrid_.x(i);
@@ -141,7 +125,7 @@ class ModelPlant {
     if (c.scalar != (sizeof(S) == 4 ? 1 : 0))
       return sizeof(S) == 4 ? "scalar: this node runs float" : "scalar: this node runs double";
     if (c.mode == NodeMode::kTwin && c.estimator == TwinEstimator::kKalman)
-      return twin_ready_ ? twin_.check(c) : "estimator kalman: send a twin image before the settings";
+      return kNoEstimator;
     if (c.mode == NodeMode::kHybrid) {
       if (!hybrid_ready_) return "mode hybrid: send a hybrid frame image before the settings";
       if (c.scene.frame.stories != N || hybrid_.stories() != N) return "frame.stories: differs from this board's";
@@ -149,7 +133,7 @@ class ModelPlant {
         return "loop.sensor_rate_hz: differs from the hybrid frame image's";
       return nullptr;
     }
-    if (!loader_.ready() || twin_image_) return "no model image: send it before the settings";
+    if (!loader_.ready()) return "no model image: send it before the settings";
     if (c.scene.frame.stories != N) return "frame.stories: differs from the model image's";
     if (c.scene.device.kind != Dev::kKind) return "device.kind: differs from the model image's";
     if constexpr (Dev::kKind == DeviceKind::kVines) {
@@ -165,6 +149,9 @@ class ModelPlant {
     return nullptr;
   }
 
+  static constexpr const char* kNoEstimator =
+      "estimator kalman: this image holds no estimator (the twin image vines_node_twin.elf does)";
+
   static void copy(const char* s, char* out, std::size_t cap) {
     std::size_t i = 0;
     for (; s[i] != '\0' && i + 1 < cap; ++i) out[i] = s[i];
@@ -178,8 +165,6 @@ class ModelPlant {
   std::uint8_t hybrid_buf_[hybrid_image_bytes(N)] = {};
   std::size_t image_total_ = 0, image_len_ = 0;
   bool hybrid_image_ = false, hybrid_ready_ = false, hybrid_mode_ = false;
-  TwinPlant<S, N> twin_;
-  bool twin_image_ = false, twin_ready_ = false, twin_mode_ = false;
   bool configured_ = false;
   std::int64_t guard_events_ = 0;
 };

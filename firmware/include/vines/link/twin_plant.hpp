@@ -1,8 +1,9 @@
 // The plant of a twin node with an estimator (link/node.hpp's Plant, twin
 // mode, estimator kalman): the estimator of twin/estimator.hpp on the twin
-// image the bench designed, its outputs as telemetry. The board's plant
-// (model_plant.hpp) and the host's (sim_host/hil_plant.cpp) both hold one,
-// so the same code runs on either.
+// image the bench designed, its outputs as telemetry. It is the whole plant
+// of the boards' twin image (firmware/app/twin_main.cpp: a monitoring node
+// holds no simulation model, whatever the building's device) and the host's
+// in that mode (sim_host/hil_plant.cpp), so the same code runs on either.
 #pragma once
 
 #include <cmath>
@@ -18,9 +19,25 @@ namespace vines::link {
 template <typename S, int N>
 class TwinPlant {
  public:
-  void image_begin() { est_.image_begin(); }
+  const char* image_begin(std::uint32_t /*total*/ = 0) {
+    est_.image_begin();
+    return nullptr;
+  }
   const char* image_push(const std::uint8_t* p, std::size_t n) { return est_.image_push(p, n); }
   const char* image_finish() { return est_.image_finish(); }
+
+  // Twin mode with the estimator only; the settings must fit the image.
+  bool configure(const NodeConfig& c, char* msg, std::size_t cap) {
+    const char* why = c.mode != NodeMode::kTwin || c.estimator != TwinEstimator::kKalman
+                          ? "mode: this node runs the twin estimator only (--mode twin --estimator kalman)"
+                          : check(c);
+    if (why && cap > 0) {
+      std::size_t i = 0;
+      for (; why[i] != '\0' && i + 1 < cap; ++i) msg[i] = why[i];
+      msg[i] = '\0';
+    }
+    return why == nullptr;
+  }
 
   // The settings must fit the twin image held: nullptr, or why not.
   const char* check(const NodeConfig& c) const {
@@ -32,11 +49,11 @@ class TwinPlant {
   }
 
   void sense(const double* y, int ny) { y_ = y, ny_ = ny; }
-  void init(double a0) {
+  void init(double a0, double /*f0*/ = 0) {
     est_.init(static_cast<S>(a0), y_, ny_);
     turn_ = 0;
   }
-  void step(double a1) { est_.step(static_cast<S>(a1), y_, ny_); }
+  void step(double a1, double /*f1*/ = 0) { est_.step(static_cast<S>(a1), y_, ny_); }
 
   // The estimated floors, top-floor acceleration and device force (on its
   // floor, N); one spring's factor and sd in turn; the alarms.
