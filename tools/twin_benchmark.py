@@ -189,7 +189,7 @@ def table(results):
         rows.append((device, label, str(len(rs)), pct(det) if damaged_run else "", pct(loc) if loc else "",
                      stat(size, "%.2f"), stat(delay, "%.1f"), "" if damaged_run else pct(det),
                      stat(nrmse, "%.4f"), "%.0f" % statistics.fmean(us)))
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
+    widths = [max([len(h)] + [len(r[i]) for r in rows]) for i, h in enumerate(head)]
     line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"
     print(line(head))
     print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
@@ -238,6 +238,8 @@ def main():
                             twin=r.get("twin"), error=r.get("error")) for r in results], f)
     print(f"twin benchmark: sensors {args.sensors} at 1 kHz, noise {args.noise_pct:g} % RMS, {len(records)} records, "
           f"{len(results) - len(errors)} runs ({len(errors)} failed)")
+    if len(errors) == len(results):
+        return 1
     table(results)
     if args.calibrate:
         worst = [max(1 - e for e in r["twin"]["eta_k"]) for r in results if "twin" in r]
