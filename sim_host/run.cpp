@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include "sim_host/build_engine.hpp"
 #include "sim_host/csv.hpp"
+#include "sim_host/digest.hpp"
 #include "sim_host/names.hpp"
 #include "sim_host/output.hpp"
 
@@ -192,6 +194,17 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
                         ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz))
                         : 0;
 
+  // The run's folder, claimed (and locked) before the run: its marker keeps
+  // what the results come from, the scene's and the record's bytes.
+  std::optional<OutputDir> out;
+  if (!opt.out_dir.empty()) {
+    Digest d;
+    d.add(scene.path);
+    d.add_file(scene.path);
+    d.add_file(ex.record.path);
+    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv"}, d.hex());
+  }
+
   // The device run, and with a device the bare frame on the same samples.
   const Trace dev = run_engine(scene, p, ex, every);
   Trace bare;
@@ -215,15 +228,14 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
 
   // The run's folder: timeseries.csv, then summary.json (the file that says the
   // run is complete) last; a timeseries.csv of an earlier run is removed.
-  if (!opt.out_dir.empty()) {
-    const OutputDir out(opt.out_dir, "vines run", {"summary.json", "timeseries.csv"});
+  if (out) {
     std::vector<std::string> written{"summary.json"};
     if (series) {
-      write_timeseries(out.file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
+      write_timeseries(out->file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
       written.push_back("timeseries.csv");
     }
-    write_file_atomic(out.file("summary.json"), r.to_json().dump(2) + '\n');
-    out.finish(written);
+    write_file_atomic(out->file("summary.json"), r.to_json().dump(2) + '\n');
+    out->finish(written);
   }
   if (opt.keep_series) {
     r.series = dev.rows;

@@ -3,10 +3,13 @@
 // finished (at most the last ~0.2 s of rows on a power cut), and
 // `vines sweep --resume DIR` runs only what is missing.
 //
-// Line 1: {"vines_sweep_log": 1, "spec": PATH, "fingerprint": HEX, "runs": N}
+// Line 1: {"vines_sweep_log": 2, "spec": PATH, "fingerprint": HEX, "runs": N}
 // Then one line per finished run, in the order they finished:
-//   {"run": INDEX, "result": RunResult as JSON}
-// Non-finite numbers of a result are written as "nan", "inf", "-inf".
+//   {"run": INDEX, "result": RunResult as JSON, "check": HEX}
+// check: the digest (digest.hpp) of the line's text before it. Non-finite
+// numbers of a result are written as "nan", "inf", "-inf". The fingerprint
+// covers the spec, its scenes, every record's bytes, the plan and vines'
+// version: a resume proves its log is this sweep's, line by line.
 #pragma once
 
 #include <condition_variable>
@@ -24,6 +27,10 @@ namespace vines::host {
 // must share: the spec's studies, their scene files and the plan.
 std::string plan_fingerprint(const SweepSpec& spec, const std::vector<RunPlan>& plan);
 
+// A run's line of the log from the JSON text of {"run": I, "result": {...}}:
+// its check appended, and the end of line.
+std::string checked_log_line(const std::string& json_text);
+
 // A log read back: the finished runs by plan index (others not done), the
 // bytes of whole valid lines, and a warning when a torn last line was left out.
 struct SweepLogContents {
@@ -34,9 +41,11 @@ struct SweepLogContents {
 };
 
 // Reads `file`; refuses (std::runtime_error naming the file and line) a log
-// of another spec or plan (fingerprint, run count) or with a bad line
-// before the last; a bad last line (torn by a kill or power cut) is left
-// out with a warning.
+// of another spec, plan, record or vines (fingerprint, run count), or with a
+// bad line: a check that does not match, a run index outside the plan or
+// seen before, a result with a member missing, unknown or of the wrong
+// type, or not finished. A last line without its end of line (a write torn
+// by a power cut) is left out with a warning.
 SweepLogContents read_sweep_log(const std::string& file, const std::string& fingerprint, std::size_t runs);
 
 // The writer: append() from any thread; each row is one write(2) of a whole

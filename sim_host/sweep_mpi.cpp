@@ -57,6 +57,13 @@ Mpi::~Mpi() {
   if (active_) MPI_Finalize();
 }
 
+bool Mpi::all(bool ok) const {
+  if (!active_) return ok;
+  int mine = ok ? 1 : 0, every = 0;
+  MPI_Allreduce(&mine, &every, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+  return every != 0;
+}
+
 void Mpi::gather(std::vector<RunResult>* results) const {
   if (!active_) return;
   std::vector<Packed> mine;
@@ -100,6 +107,7 @@ void Mpi::gather(std::vector<RunResult>* results) const {
 Mpi::Mpi() = default;
 Mpi::~Mpi() = default;
 void Mpi::gather(std::vector<RunResult>*) const {}
+bool Mpi::all(bool ok) const { return ok; }
 
 #endif
 

@@ -19,6 +19,8 @@ class Mpi {
   int size() const { return size_; }
   // Collects every rank's finished runs into rank 0's vector.
   void gather(std::vector<RunResult>* results) const;
+  // Whether every rank says ok (each rank waits for all).
+  bool all(bool ok) const;
 
  private:
   int rank_ = 0, size_ = 1;

@@ -34,7 +34,7 @@ no_temp() { [[ -z $(find "$1" -name '.*.tmp-*') ]] || fail "temporary files left
 "$vines" run "$tmp/short.toml" --out "$tmp/run" --quiet
 cp -r "$tmp/run" "$tmp/run.before"
 expect_efbig "$tmp/run/timeseries.csv" "$vines" run "$tmp/short.toml" --out "$tmp/run" --quiet
-diff -r "$tmp/run.before" "$tmp/run" > /dev/null || fail "vines run: earlier results changed by a failed run"
+diff -r -x .vines-output "$tmp/run.before" "$tmp/run" > /dev/null || fail "vines run: earlier results changed by a failed run"
 no_temp "$tmp/run"
 echo "run: write failure reported, earlier results intact"
 
@@ -91,4 +91,53 @@ sed 's/^name = .*/name = "..\/..\/evil"/' "$tmp/noseries.toml" > "$tmp/w/c/evil.
 [[ -f $tmp/w/c/out/___.._evil/summary.json ]] || fail "no out/___.._evil/summary.json: $(find "$tmp/w")"
 [[ ! -e $tmp/evil && ! -e $tmp/w/evil ]] || fail "a scene name wrote outside out/"
 echo "name ../../evil: written to out/___.._evil/"
+# Refused with exit 1 and TEXT in the message: refused TEXT COMMAND...
+refused() {
+  local text=$1; shift
+  set +e
+  "$@" > /dev/null 2> "$tmp/err.txt"
+  local rc=$?
+  set -e
+  [[ $rc == 1 ]] || fail "$*: exit $rc, not 1"
+  grep -qF -- "$text" "$tmp/err.txt" || fail "$*: the refusal does not say \"$text\": $(cat "$tmp/err.txt")"
+}
+
+# No write through a link: a link (or a hard link) named like an output in a
+# vines folder refuses the folder, and the file it leads to is untouched.
+echo secret > "$tmp/victim.txt"
+"$vines" run "$tmp/noseries.toml" --out "$tmp/linked" --quiet
+ln -s "$tmp/victim.txt" "$tmp/linked/timeseries.csv"
+refused "timeseries.csv (a link)" "$vines" run "$tmp/short.toml" --out "$tmp/linked" --quiet
+rm "$tmp/linked/timeseries.csv" "$tmp/linked/summary.json"
+ln "$tmp/victim.txt" "$tmp/linked/summary.json"
+refused "summary.json (a hard link)" "$vines" run "$tmp/noseries.toml" --out "$tmp/linked" --quiet
+[[ $(cat "$tmp/victim.txt") == secret ]] || fail "a file behind a link was written"
+ln -s "$tmp/victim.txt" "$tmp/hil_link.csv"
+refused "$tmp/hil_link.csv: cannot write: a symbolic link" "$vines" hil "$tmp/short.toml" --duration 0.2 \
+  --csv "$tmp/hil_link.csv"
+[[ $(cat "$tmp/victim.txt") == secret ]] || fail "vines hil --csv wrote through a link"
+echo "links: refused, the files behind them untouched"
+
+# Ownership by the marker: someone else's summary.json, results.csv or
+# runs.jsonl in a folder without it is not vines'; nor is a sweep's folder a run's.
+mkdir "$tmp/theirs"
+echo '{"mine": true}' > "$tmp/theirs/summary.json"
+refused "no .vines-output marker" "$vines" run "$tmp/noseries.toml" --out "$tmp/theirs" --quiet
+refused "no .vines-output marker" "$vines" sweep "$spec" --out "$tmp/theirs" --no-progress
+[[ $(cat "$tmp/theirs/summary.json") == '{"mine": true}' ]] || fail "someone else's summary.json overwritten"
+refused "vines sweep's folder, not vines run's" "$vines" run "$tmp/noseries.toml" --out "$tmp/sweep" --quiet
+echo "ownership: a folder without vines' marker, or another command's, refused"
+
+# One command at a time: a sweep under way holds its folder; a second one is
+# refused, naming the first; after it, the folder is free.
+sed -e 's|"loop.contact_rtol" = 1e-6|"loop.contact_rtol" = 1e-12|' -e "s|scene = \"../|scene = \"$src/data/|" \
+  "$src/data/studies/initial_conditions.toml" > "$tmp/slow.toml"
+"$vines" sweep "$tmp/slow.toml" --threads 1 --out "$tmp/busy" --no-progress > /dev/null 2>&1 &
+first=$!
+for _ in $(seq 100); do grep -q '"pid"' "$tmp/busy/.vines-output" 2> /dev/null && break; sleep 0.05; done
+refused "in use by vines sweep (process $first)" "$vines" sweep "$spec" --out "$tmp/busy" --no-progress
+kill -INT "$first"
+wait "$first" || true
+"$vines" sweep "$spec" --out "$tmp/busy" --no-progress > /dev/null 2>&1 || fail "the folder stayed locked"
+echo "lock: a second sweep on a busy folder refused, naming the first"
 echo "output_cli: ok"

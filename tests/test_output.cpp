@@ -153,12 +153,17 @@ TEST_F(OutputTest, MissingFolderIsNamedWithTheReason) {
             path("no/such/a.json") + ": cannot write: No such file or directory");
 }
 
-TEST_F(OutputTest, SymbolicLinkStaysAndItsFileIsReplaced) {
+TEST_F(OutputTest, SymbolicLinkIsRefusedAndItsFileKept) {
   write_file_atomic(path("real.csv"), "old\n");
   fs::create_symlink("real.csv", dir_ / "link.csv");
-  write_file_atomic(path("link.csv"), "new\n");
+  EXPECT_EQ(message_of([&] { write_file_atomic(path("link.csv"), "new\n"); }),
+            path("link.csv") + ": cannot write: a symbolic link (vines writes no file through a link: remove it or "
+                               "give another path)");
   EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
-  EXPECT_EQ(read(path("real.csv")), "new\n");
+  EXPECT_EQ(read(path("real.csv")), "old\n");
+  fs::create_symlink("nowhere.csv", dir_ / "dangling.csv");  // would create a file elsewhere
+  EXPECT_NE(message_of([&] { write_file_atomic(path("dangling.csv"), "new\n"); }), "");
+  EXPECT_FALSE(fs::exists(dir_ / "nowhere.csv"));
 }
 
 TEST(Output, DeviceIsWrittenInPlace) {
@@ -191,33 +196,82 @@ TEST_F(OutputTest, FolderIsCreated) {
 }
 
 TEST_F(OutputTest, FinishRemovesStaleFilesOfTheCommand) {
+  { const OutputDir earlier(dir_.string(), "vines run", {"summary.json", "timeseries.csv"}); }
   write_file_atomic(path("summary.json"), "old");
   write_file_atomic(path("timeseries.csv"), "old");
   write_file_atomic(path(".timeseries.csv.tmp-abc123"), "left by a kill");
   const OutputDir out(dir_.string(), "vines run", {"summary.json", "timeseries.csv"});
   write_file_atomic(out.file("summary.json"), "new");
   out.finish({"summary.json"});
-  EXPECT_EQ(names(), std::set<std::string>{"summary.json"});
+  EXPECT_EQ(names(), (std::set<std::string>{".vines-output", "summary.json"}));
   EXPECT_EQ(read(path("summary.json")), "new");
 }
 
 TEST_F(OutputTest, PatternsNameTheCommandsFiles) {
+  const std::vector<std::string> owned{"stress.json", "case_*.toml", "case_*_record.txt"};
+  { const OutputDir earlier(dir_.string(), "vines stress", owned); }
   write_file_atomic(path("case_7.toml"), "old");
   write_file_atomic(path("case_7_record.txt"), "old");
-  const OutputDir out(dir_.string(), "vines stress", {"stress.json", "case_*.toml", "case_*_record.txt"});
+  const OutputDir out(dir_.string(), "vines stress", owned);
   write_file_atomic(out.file("case_9.toml"), "new");
   out.finish({"case_9.toml"});
-  EXPECT_EQ(names(), std::set<std::string>{"case_9.toml"});
+  EXPECT_EQ(names(), (std::set<std::string>{".vines-output", "case_9.toml"}));
 }
 
-TEST_F(OutputTest, FolderWithForeignFilesIsRefusedAndLeftAlone) {
-  write_file_atomic(path("summary.json"), "old");
+// Ownership by the marker, not by file names: a folder of files named like a
+// command's outputs, without the marker vines writes, is not vines'.
+TEST_F(OutputTest, FolderWithoutTheMarkerIsRefusedAndLeftAlone) {
+  write_file_atomic(path("summary.json"), "someone else's");
+  const std::string msg = message_of([&] { OutputDir(dir_.string(), "vines run", {"summary.json"}); });
+  EXPECT_EQ(msg, dir_.string() + ": holds files but no .vines-output marker, so no vines made it (summary.json): "
+                                 "give an empty or new folder");
+  EXPECT_EQ(names(), std::set<std::string>{"summary.json"});
+  EXPECT_EQ(read(path("summary.json")), "someone else's");
+}
+
+TEST_F(OutputTest, FolderWithForeignFilesOrLinksIsRefusedAndLeftAlone) {
+  { const OutputDir earlier(dir_.string(), "vines run", {"summary.json", "timeseries.csv"}); }
   write_file_atomic(path("notes.txt"), "mine");
   fs::create_directories(dir_ / "plots");
-  const std::string msg = message_of([&] { OutputDir(dir_.string(), "vines run", {"summary.json"}); });
-  EXPECT_EQ(msg, dir_.string() + ": holds files vines run does not write (notes.txt, plots/): give an empty or new "
-                                 "folder, or one of vines run's own");
-  EXPECT_EQ(names(), (std::set<std::string>{"summary.json", "notes.txt", "plots"}));
+  write_file_atomic(path("elsewhere.json"), "someone else's");
+  fs::create_symlink("elsewhere.json", dir_ / "summary.json");
+  fs::create_hard_link(dir_ / "notes.txt", dir_ / "timeseries.csv");
+  const std::string msg =
+      message_of([&] { OutputDir(dir_.string(), "vines run", {"summary.json", "timeseries.csv"}); });
+  EXPECT_EQ(msg, dir_.string() + ": holds files vines run does not write (elsewhere.json, notes.txt (a hard link), "
+                                 "plots/, summary.json (a link), timeseries.csv (a hard link)): give an empty or "
+                                 "new folder, or one of vines run's own");
+  EXPECT_EQ(read(path("elsewhere.json")), "someone else's");
+}
+
+// The folder is locked while its command writes: a second command is refused,
+// naming the first; another command's folder is refused; the lock goes with
+// the command.
+TEST_F(OutputTest, FolderInUseOrOfAnotherCommandIsRefused) {
+  {
+    const OutputDir first(dir_.string(), "vines sweep", {"results.csv"}, "abc");
+    EXPECT_EQ(message_of([&] { OutputDir(dir_.string(), "vines sweep", {"results.csv"}); }),
+              dir_.string() + ": in use by vines sweep (process " + std::to_string(::getpid()) +
+                  "): wait for it to end, or give another folder");
+  }
+  const OutputDir again(dir_.string(), "vines sweep", {"results.csv"});
+  EXPECT_EQ(message_of([&] { OutputDir(path("."), "vines run", {"summary.json"}); }),
+            path(".") + ": in use by vines sweep (process " + std::to_string(::getpid()) +
+                "): wait for it to end, or give another folder");
+}
+
+TEST_F(OutputTest, AnotherCommandsFolderOrAForgedMarkerIsRefused) {
+  { const OutputDir sweep(dir_.string(), "vines sweep", {"results.csv"}); }
+  EXPECT_EQ(message_of([&] { OutputDir(dir_.string(), "vines run", {"summary.json"}); }),
+            dir_.string() + ": vines sweep's folder, not vines run's: give another folder");
+  write_file_atomic(path(".vines-output"), "not json");
+  EXPECT_EQ(message_of([&] { OutputDir(dir_.string(), "vines sweep", {"results.csv"}); }),
+            dir_.string() + ": .vines-output is not a vines marker: give another folder");
+  fs::remove(dir_ / ".vines-output");
+  write_file_atomic(path("target"), "{}");
+  fs::create_symlink("target", dir_ / ".vines-output");
+  EXPECT_EQ(message_of([&] { OutputDir(dir_.string(), "vines sweep", {"results.csv"}); }),
+            path(".vines-output") + ": not a file vines wrote (a link or a folder): refusing the folder");
 }
 
 TEST_F(OutputTest, EmptyPathAndFileInTheWayAreRefused) {

@@ -91,7 +91,8 @@ struct Log : ::testing::Test {
 TEST_F(Log, RowsComeBackBitForBitWithNonFiniteNumbers) {
   SweepLog log(file, spec.path, fingerprint, plan.size(), 0);
   log.append(3, result(0.123456789012345678));
-  RunResult failed;
+  RunResult failed;  // a failed run is finished too (run_one)
+  failed.done = true;
   failed.error = "a \"quoted\"\nmessage";
   log.append(7, failed);
   log.close();
@@ -159,9 +160,84 @@ TEST_F(Log, ALogOfAnotherPlanOrABadLineBeforeTheLastIsRefused) {
   // A damaged line with whole lines after it is corruption, not a torn end.
   std::ofstream(file, std::ios::app) << "{not json\n" << R"({"run": 1, "result": {}})" << '\n';
   EXPECT_NE(refusal(fingerprint, plan.size()).find("runs.jsonl:3: bad line in the log"), std::string::npos);
+  // So is a bad last line with its end of line: only a torn one is left out.
+  {
+    SweepLog log(file, spec.path, fingerprint, plan.size(), 0);
+    log.append(0, result(0.5));
+    log.close();
+  }
+  std::ofstream(file, std::ios::app) << "{not json\n";
+  EXPECT_NE(refusal(fingerprint, plan.size()).find("runs.jsonl:3: bad line in the log"), std::string::npos);
   std::ofstream(file, std::ios::trunc) << "x,y\n1,2\n";
   EXPECT_NE(refusal(fingerprint, plan.size()).find("not a vines sweep log"), std::string::npos);
   EXPECT_THROW(read_sweep_log((dir / "none.jsonl").string(), fingerprint, plan.size()), std::runtime_error);
+}
+
+// Every line proves itself: its check, its run's index (in the plan, once),
+// its result's members (each present, known, of its type) and that it
+// finished. Lines an attacker or a broken writer made, each with a good
+// check, are refused with their line number.
+TEST_F(Log, EveryLineIsCheckedAndABadOneStopsTheResume) {
+  const std::string good = R"({"result":{"E_r":0.5,"bad_samples":0,"cap_hits":0,"contacts":3,"degraded":false,)"
+                           R"("degraded_reasons":"","device":"vines","divergences":0,"done":true,)"
+                           R"("elastic_energy":1.0,"energy_checked":true,"error":"","max_overlap":0.0,)"
+                           R"("peak_top":0.2,"residual":0.0,"x_r":0.25},"run":1})";
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    const std::size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  auto verdict = [&](const std::vector<std::string>& lines) {
+    {
+      SweepLog log(file, spec.path, fingerprint, plan.size(), 0);
+      log.close();
+    }
+    {
+      std::ofstream f(file, std::ios::app);
+      for (const std::string& l : lines) f << l;
+    }
+    try {
+      return "accepted " + std::to_string(read_sweep_log(file, fingerprint, plan.size()).finished);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+  };
+  const std::string at2 = file + ":2: bad line in the log: ";
+  EXPECT_EQ(verdict({checked_log_line(good)}), "accepted 1");
+  EXPECT_EQ(verdict({checked_log_line(with("\"x_r\":0.25", "\"x_r\":\"0.5\""))}), at2 + "\"x_r\" is not a number");
+  EXPECT_EQ(verdict({checked_log_line(with(",\"contacts\":3", ""))}), at2 + "its result lacks \"contacts\"");
+  EXPECT_EQ(verdict({checked_log_line(with("\"done\":true", "\"done\":false"))}),
+            at2 + "its result is not finished (\"done\": false)");
+  EXPECT_EQ(verdict({checked_log_line(with("\"run\":1", "\"run\":-1"))}), at2 + "its run is not an index");
+  EXPECT_EQ(verdict({checked_log_line(with("\"run\":1", "\"run\":15"))}), at2 + "run 15 is not in the plan");
+  EXPECT_EQ(verdict({checked_log_line(with("\"x_r\"", "\"x_rr\""))}),
+            at2 + "its result has an unknown member \"x_rr\"");
+  EXPECT_EQ(verdict({checked_log_line(with("\"contacts\":3", "\"contacts\":3.5"))}), at2 + "\"contacts\" is not a count");
+  EXPECT_EQ(verdict({checked_log_line(good), checked_log_line(good)}),
+            file + ":3: bad line in the log: run 1 is also on line 2");
+  std::string flipped = checked_log_line(good);
+  flipped[flipped.find("0.25") + 3] = '6';
+  EXPECT_EQ(verdict({flipped}), at2 + "its check does not match its text (damaged)");
+  EXPECT_EQ(verdict({good + "\n"}), at2 + "no check at its end");
+}
+
+// The fingerprint covers every record's bytes: a record changed between a
+// sweep and its resume is another plan.
+TEST_F(Log, ARecordChangedSinceTheSweepIsAnotherPlan) {
+  const fs::path rec = dir / "record.txt", scene = dir / "scene.toml", spec_file = dir / "spec.toml";
+  fs::copy_file(fs::path(VINES_SOURCE_DIR) / "../shared/data/ground_motions/elcentro_1940_ns_2688pts_dt002_time_g.dat",
+                rec);
+  std::ofstream(scene) << "[device]\nkind = \"none\"\n[record]\npath = \"record.txt\"\nformat = \"time-accel\"\n"
+                          "units = \"g\"\n";
+  std::ofstream(spec_file) << "[[study]]\nname = \"r\"\nscene = \"scene.toml\"\n[study.grid]\n"
+                              "\"frame.stiffness_scale\" = [0.9, 1.0]\n";
+  const SweepSpec s = load_sweep(spec_file.string());
+  const std::vector<RunPlan> p = plan_runs(s);
+  const std::string before = plan_fingerprint(s, p);
+  EXPECT_EQ(plan_fingerprint(s, p), before);
+  std::ofstream(rec, std::ios::app) << "60.0 0.01\n";
+  EXPECT_NE(plan_fingerprint(s, p), before);
 }
 
 TEST_F(Log, AGridBeyondAnyMachineIsRefusedFromItsCounts) {

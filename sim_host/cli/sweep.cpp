@@ -5,8 +5,10 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -92,9 +94,23 @@ int sweep(SweepArgs a) {
   if (!a.resume_dir.empty()) opt.out_dir = a.resume_dir;
   else if (a.out->count() == 0)
     opt.out_dir = "out/" + safe_file_name(std::filesystem::path(a.spec_path).stem().string());
-  // The folder is claimed before the runs, by every rank (a refusal stops them
-  // all alike, none is left waiting for rank 0); rank 0 writes it.
-  const OutputDir out(opt.out_dir, "vines sweep", {"results.csv", "summary.json", "runs.jsonl"});
+  // The folder is claimed (and locked) before the runs by rank 0, which
+  // writes it; its refusal stops every rank alike, none is left waiting.
+  const std::string fingerprint = plan_fingerprint(spec, plan);
+  std::optional<OutputDir> out;
+  std::exception_ptr refused;
+  if (mpi.rank() == 0) {
+    try {
+      out.emplace(opt.out_dir, "vines sweep", std::vector<std::string>{"results.csv", "summary.json", "runs.jsonl"},
+                  fingerprint);
+    } catch (const std::exception&) {
+      refused = std::current_exception();
+    }
+  }
+  if (!mpi.all(refused == nullptr)) {
+    if (refused) std::rethrow_exception(refused);
+    return kRefused;  // rank 0 says why
+  }
   // The log of finished runs (one process only): read back with --resume, then appended to.
   std::unique_ptr<SweepLog> log;
   std::vector<RunResult> finished;
@@ -102,7 +118,6 @@ int sweep(SweepArgs a) {
   const std::string log_file = (std::filesystem::path(opt.out_dir) / "runs.jsonl").string();
   if (!a.resume_dir.empty() && mpi.size() > 1) throw std::runtime_error("--resume: not under MPI (no log is kept)");
   if (mpi.size() == 1) {
-    const std::string fingerprint = plan_fingerprint(spec, plan);
     std::size_t keep = 0;
     if (!a.resume_dir.empty()) {
       SweepLogContents c = read_sweep_log(log_file, fingerprint, plan.size());
@@ -124,7 +139,7 @@ int sweep(SweepArgs a) {
   if (mpi.rank() != 0) return kOk;
   const int cores = map_threads(opt.threads) * mpi.size();
   const SweepSummary s = write_sweep(spec, plan, results, opt.out_dir, wall, cores);
-  out.finish({"results.csv", "summary.json", "runs.jsonl"});
+  out->finish({"results.csv", "summary.json", "runs.jsonl"});
   // The rate of the runs run now (a resumed sweep read the others from its log).
   const std::size_t ran = s.done - resumed;
   const std::string from_log = resumed > 0 ? " (" + std::to_string(resumed) + " from the log)" : "";
