@@ -2,6 +2,7 @@
 // in sim_host/cli/, one file each; this builds the app from them and turns what
 // happened into the exit status (cli.hpp: 0, 1 refused input, 2 usage, 3
 // degraded results, 130).
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
@@ -9,6 +10,10 @@
 
 int main(int argc, char** argv) {
   using namespace vines::cli;
+  // A file-size limit (ulimit -f) is a write error like a full disk: the write
+  // fails with EFBIG, named with its file (exit 1), instead of SIGXFSZ
+  // killing the process and leaving its temporary file.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App vines("vines - Vibro-Impact Nonlinear Energy Sink firmware model (host build)", "vines");
   vines.footer("Records are looked up as given, next to the scene file, then in $VINES_GROUND_MOTIONS (default: "
                "../shared/data/ground_motions beside the repository).\nExit status: 0 done, 1 refused input or a "

@@ -38,6 +38,17 @@ diff -r -x .vines-output "$tmp/run.before" "$tmp/run" > /dev/null || fail "vines
 no_temp "$tmp/run"
 echo "run: write failure reported, earlier results intact"
 
+# The same with SIGXFSZ at its default (which kills the process): vines
+# ignores it, so the limit is a write error with its message and exit 1.
+set +e
+(ulimit -f 1; "$vines" run "$tmp/short.toml" --out "$tmp/xfsz" --quiet > /dev/null 2> "$tmp/err.txt")
+rc=$?
+set -e
+[[ $rc == 1 ]] || fail "a file-size limit with SIGXFSZ at its default: exit $rc, not 1"
+grep -qF "timeseries.csv: cannot write: File too large" "$tmp/err.txt" || fail "no message: $(cat "$tmp/err.txt")"
+no_temp "$tmp/xfsz"
+echo "run: SIGXFSZ is a write error, not a silent death"
+
 # A run without timeseries.csv removes the earlier one; a foreign file refuses the folder.
 "$vines" run "$tmp/noseries.toml" --out "$tmp/run" --quiet
 [[ -f $tmp/run/summary.json && ! -e $tmp/run/timeseries.csv ]] || fail "stale timeseries.csv kept: $(ls "$tmp/run")"
