@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "sim_host/cli/cli.hpp"
+#include "sim_host/printable.hpp"
 
 int main(int argc, char** argv) {
   using namespace vines::cli;
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return report_parse_error(vines, e);
   } catch (const std::exception& e) {  // refused input
-    std::fprintf(stderr, "vines %s: %s\n", vines.get_subcommands().front()->get_name().c_str(), e.what());
+    std::fprintf(stderr, "vines %s: %s\n", vines.get_subcommands().front()->get_name().c_str(),
+                 vines::host::printable(e.what()).c_str());
     return kRefused;
   }
 }

@@ -80,5 +80,21 @@ if ! grep -q 'vines.radius_m: the Hertz contact lasts' "$WORK/sweep/results.csv"
   failed=$((failed + 1))
 fi
 
+# A file's bytes in a message are escaped and cut: an escape sequence does
+# not reach the terminal raw, a 1 MB token is not printed whole.
+printf '0 1\n0.01 \033[31mred\033[0m\n' > "$WORK/esc.txt"
+expect 1 'non-numeric token' -- "$VINES" run data/scenes/elcentro_vines.toml --record "$WORK/esc.txt"
+if grep -q $'\033' "$WORK/err" || ! grep -qF '\x1b[31mred' "$WORK/err"; then
+  echo "FAIL: an escape sequence from a record reached the terminal raw:"; cat -v "$WORK/err"; failed=$((failed + 1))
+fi
+{ printf '0 1\n0.01 '; head -c 1000000 /dev/zero | tr '\0' 'x'; printf '\n'; } > "$WORK/long.txt"
+expect 1 'more bytes)' -- "$VINES" run data/scenes/elcentro_vines.toml --record "$WORK/long.txt"
+if [ "$(wc -c < "$WORK/err")" -gt 2000 ]; then
+  echo "FAIL: a 1 MB token printed whole ($(wc -c < "$WORK/err") bytes)"; failed=$((failed + 1))
+fi
+# A file-size limit with SIGXFSZ at its default: a write error, exit 1.
+(ulimit -f 1; expect 1 "cannot write: File too large" -- "$VINES" run data/scenes/elcentro_vines.toml \
+  --out "$WORK/xf"; exit "$failed") || failed=$((failed + 1))
+
 echo "input_cli: $failed failed"
 [ "$failed" -eq 0 ]

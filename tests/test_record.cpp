@@ -252,6 +252,20 @@ TEST_F(RecordFiles, BadHeaderDt) {
   EXPECT_EQ(error_of(spec_for(vel)), vel + ":3: not an acceleration record");
 }
 
+// A header's DT that is not a number is named as such (not taken for no
+// header); units vines does not know are refused, not read as g; a record of
+// one point is refused in every format.
+TEST_F(RecordFiles, HeaderDtUnitsAndOnePointAreChecked) {
+  const std::string nan = write("nan.at2", "PEER\nNPTS= 2, DT=nan\n1 2\n");
+  EXPECT_EQ(error_of(spec_for(nan)), nan + ":2: non-finite value 'nan'");
+  const std::string inch = write("in.at2", "ACCELERATION IN UNITS OF IN/S/S\nNPTS= 2, DT= .01 SEC\n1 2\n");
+  EXPECT_EQ(error_of(spec_for(inch)), inch + ":1: unknown units 'IN/S/S' (vines reads g, gal, cm/s2, m/s2)");
+  const std::string one = write("one.at2", "UNITS OF G\nNPTS= 1, DT= .01 SEC\n1\n");
+  EXPECT_EQ(error_of(spec_for(one)), one + ": a record needs at least 2 points, it has 1");
+  const std::string col = write("one.txt", "0.0 1.0\n");
+  EXPECT_NE(error_of(spec_for(col)).find("at least 2"), std::string::npos);
+}
+
 TEST_F(RecordFiles, BadTimeColumn) {
   const std::string same = write("s.txt", "0 1\n0.02 1\n0.02 1\n0.06 1\n");
   EXPECT_NE(error_of(spec_for(same)).find(same + ":3: time does not increase"), std::string::npos);

@@ -115,7 +115,15 @@ TEST_F(RecordFiles, OverrideFormatIsForced) {
   RecordReading how;
   how.format = RecordFormat::kAccel;
   how.dt_s = 0.005;
-  EXPECT_EQ(load_excitation(tmd_scene(), cols, how).record.accel_mps2.size(), 6u);
+  const std::string pairs = write("pairs.txt", "0.1 0.2\n0.3 0.1\n-0.2 0.4\n");  // accelerations, two a line
+  EXPECT_EQ(load_excitation(tmd_scene(), pairs, how).record.accel_mps2.size(), 6u);
+  // A time column is not read as accelerations.
+  try {
+    load_excitation(tmd_scene(), cols, how);
+    ADD_FAILURE() << "a time column read as accelerations";
+  } catch (const RecordError& e) {
+    EXPECT_NE(std::string(e.what()).find("a time column (use format \"time-accel\""), std::string::npos) << e.what();
+  }
   RecordReading at2;
   at2.format = RecordFormat::kTimeAccel;
   const std::string kobe = motions_dir() + "/kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2";

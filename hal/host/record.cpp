@@ -133,10 +133,13 @@ struct At2Header {
 
 std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const std::string& path) {
   static const std::regex npts_re(R"(\bNPTS\s*=\s*(\d+))", std::regex::icase);
-  static const std::regex dt_re(R"(\bDT\s*=\s*([0-9.Ee+-]+))", std::regex::icase);
+  static const std::regex dt_re(R"(\bDT\s*=\s*([^\s,]*))", std::regex::icase);
   static const std::regex units_re(
       R"((?:units\s+(?:are\s+|of\s+|in\s+)*\(?|\()\s*(gal|cm/s(?:ec)?|m/s(?:ec)?|g)(?![a-z]))",
       std::regex::icase);
+  // A header that names its units, whatever they are: unknown ones are refused, not read as g.
+  static const std::regex named_units_re(R"(units\s+(?:are\s+|of\s+|in\s+)*\(?\s*([^\s),.;]+))",
+                                         std::regex::icase);
   static const std::regex not_accel_re(R"(\b(velocity|displacement)\s+time\s+(series|history))",
                                        std::regex::icase);
 
@@ -152,7 +155,13 @@ std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const s
     const auto r = std::from_chars(npts.data(), npts.data() + npts.size(), h.npts);
     if (r.ec != std::errc() || h.npts == 0) fail(path, lines[i].number, "bad NPTS '" + npts + "'");
     check_count(path + ":" + std::to_string(lines[i].number), h.npts, "points (NPTS)");
-    h.dt = parse_number(dt_m[1].str(), path, lines[i].number);
+    // The time step, less a unit glued to it (".0200SEC").
+    std::string dt = dt_m[1].str();
+    while (dt.size() > 1 && std::isalpha(static_cast<unsigned char>(dt.back())) && dt.back() != 'n' &&
+           dt.back() != 'N' && dt.back() != 'f' && dt.back() != 'F')
+      dt.pop_back();
+    if (dt.empty()) fail(path, lines[i].number, "no value after DT=");
+    h.dt = parse_number(dt, path, lines[i].number);
     if (!(h.dt > 0.0)) fail(path, lines[i].number, "DT must be positive, got " + dt_m[1].str());
 
     // Header lines up to the NPTS line: refuse velocity/displacement files
@@ -162,7 +171,12 @@ std::optional<At2Header> find_at2_header(const std::vector<Line>& lines, const s
       if (std::regex_search(lines[j].text, not_accel_re)) {
         fail(path, lines[j].number, "not an acceleration record");
       }
-      if (h.units || !std::regex_search(lines[j].text, m, units_re)) continue;
+      if (h.units) continue;
+      if (!std::regex_search(lines[j].text, m, units_re)) {
+        if (std::regex_search(lines[j].text, m, named_units_re))
+          fail(path, lines[j].number, "unknown units '" + m[1].str() + "' (vines reads g, gal, cm/s2, m/s2)");
+        continue;
+      }
       const char c0 = static_cast<char>(std::tolower(static_cast<unsigned char>(m[1].str()[0])));
       h.units = m[1].length() == 1 ? Units::kG : c0 == 'm' ? Units::kMps2 : Units::kCmps2;
     }
@@ -288,12 +302,41 @@ void check_dt(const std::string& path, double dt) {
 // column that starts late; the run would simulate it all).
 void check_extent(const std::string& path, std::size_t points, double dt, double t0) {
   check_count(path, points, "points");
+  // One rule in every format: a record is at least two points (one interval).
+  if (points < 2) fail(path, "a record needs at least 2 points, it has " + std::to_string(points));
   check_dt(path, dt);
   const double end_s = t0 + dt * static_cast<double>(points);
   if (!(end_s <= kMaxRecordEndS)) {
     fail(path, "the record ends at t = " + fmt(end_s) + " s, later than the " + fmt(kMaxRecordEndS) +
                    " s a record may last (check DT or the time column)");
   }
+}
+
+// A file forced to "accel" whose rows are all of two or more columns, the
+// first rising by one step: a time column, which would be read as
+// accelerations.
+void refuse_time_column(const std::vector<Line>& lines, const std::string& path) {
+  std::vector<double> first;
+  std::size_t columns = 0;
+  for (const Line& l : lines) {
+    const auto toks = tokens(l.text, true);
+    if (toks.empty()) continue;
+    if (columns == 0) columns = toks.size();
+    if (toks.size() != columns || columns < 2) return;
+    std::string t(toks[0]);
+    double v = 0;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return;
+    first.push_back(v);
+  }
+  if (first.size() < 3) return;
+  const double step = first[1] - first[0];
+  if (!(step > 0)) return;
+  for (std::size_t i = 1; i < first.size(); ++i)
+    if (std::abs(first[i] - first[i - 1] - step) > 1e-6 * std::max(step, std::abs(first[i]))) return;
+  fail(path, "format accel, but every row has " + std::to_string(columns) +
+                 " columns and the first rises by " + fmt(step) +
+                 " each row: a time column (use format \"time-accel\", or \"auto\")");
 }
 
 // ---- from_lines: pick the format, parse, convert to m/s^2 ----
@@ -309,6 +352,7 @@ Record from_lines(const std::vector<Line>& lines, const RecordSpec& spec) {
     fail(spec.path, "no 'NPTS= .., DT= ..' header line in the first " +
                         std::to_string(kHeaderSearchLines) + " lines");
   } else if (spec.format == RecordFormat::kAccel) {
+    refuse_time_column(lines, spec.path);
     raw = parse_accel(lines, spec);
   } else {
     // Time/accel, or (auto) a single column of accelerations.

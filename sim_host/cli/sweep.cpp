@@ -16,6 +16,7 @@
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/output.hpp"
 #include "sim_host/parallel.hpp"
+#include "sim_host/printable.hpp"
 #include "sim_host/sweep.hpp"
 #include "sim_host/sweep_log.hpp"
 #include "sim_host/sweep_mpi.hpp"
@@ -121,7 +122,7 @@ int sweep(SweepArgs a) {
     std::size_t keep = 0;
     if (!a.resume_dir.empty()) {
       SweepLogContents c = read_sweep_log(log_file, fingerprint, plan.size());
-      if (!c.warning.empty()) std::fprintf(stderr, "vines sweep: warning: %s\n", c.warning.c_str());
+      if (!c.warning.empty()) std::fprintf(stderr, "vines sweep: warning: %s\n", printable(c.warning).c_str());
       std::fprintf(stderr, "vines sweep: resuming %s: %zu of %zu runs finished, %zu to run\n", log_file.c_str(),
                    c.finished, plan.size(), plan.size() - c.finished);
       keep = c.good_bytes;
