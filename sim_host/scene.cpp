@@ -261,11 +261,42 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   return scene_from_table(parse_scene_table(toml_text, origin), origin);
 }
 
+// ---- the format: each table's keys ----
+namespace {
+const std::initializer_list<std::string_view> kTables = {"scene", "frame",  "device", "tmd",
+                                                         "vines", "record", "loop",   "output"};
+const std::initializer_list<std::string_view> kSceneKeys = {"name"};
+const std::initializer_list<std::string_view> kFrameKeys = {
+    "preset", "masses_kg", "stiffnesses_n_per_m", "damping", "stiffness_damping_s", "rayleigh_zeta",
+    "rayleigh_modes", "modal_zeta", "stiffness_scale", "stiffness_scales"};
+const std::initializer_list<std::string_view> kDeviceKeys = {"kind", "floor", "mass_ratio", "mass_kg"};
+const std::initializer_list<std::string_view> kTmdKeys = {"k_n_per_m", "c_ns_per_m", "initial_position_m",
+                                                          "initial_velocity_mps"};
+const std::initializer_list<std::string_view> kVinesKeys = {
+    "radius_m", "density_kg_m3", "young_pa", "poisson", "wall_young_pa", "wall_poisson", "beta",
+    "box_length_m", "law", "eps", "v_ref_mps", "tau_s", "initial_position_m", "initial_velocity_mps"};
+const std::initializer_list<std::string_view> kRecordKeys = {"path",   "format", "units",   "dt_s",
+                                                             "column", "scale",  "pga_g", "duration_s"};
+const std::initializer_list<std::string_view> kLoopKeys = {
+    "sensor_rate_hz", "contact_rtol",   "max_substeps_per_step", "contact_count_depth_m", "energy_ledger",
+    "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "scalar"};
+const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries"};
+}  // namespace
+
+bool is_scene_key(const std::string& dotted) {
+  const std::size_t dot = dotted.find('.');
+  if (dot == std::string::npos) return false;
+  const std::string_view table(dotted.data(), dot), key(dotted.data() + dot + 1, dotted.size() - dot - 1);
+  for (const auto& [name, keys] : {std::pair{"scene", kSceneKeys}, {"frame", kFrameKeys}, {"device", kDeviceKeys},
+                                   {"tmd", kTmdKeys}, {"vines", kVinesKeys}, {"record", kRecordKeys},
+                                   {"loop", kLoopKeys}, {"output", kOutputKeys}})
+    if (table == name) return std::find(keys.begin(), keys.end(), key) != keys.end();
+  return false;
+}
+
 // ---- table -> checked Scene ----
 Scene scene_from_table(const toml::table& root, const std::string& origin) {
   // Top level: only the known tables.
-  const std::initializer_list<std::string_view> kTables = {"scene", "frame",  "device", "tmd",
-                                                           "vines", "record", "loop",   "output"};
   for (auto&& kv : root)
     if (std::find(kTables.begin(), kTables.end(), kv.first.str()) == kTables.end())
       fail(origin, &kv.first.source(), std::string(kv.first.str()),
@@ -277,41 +308,27 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
   SceneParams& p = scene.params;
   p.loop.floor_peaks = true;  // a scene's run reports every floor unless told not to
 
-  const Section meta(origin, root, "scene", {"name"});
+  const Section meta(origin, root, "scene", kSceneKeys);
   if (meta.read("name", &scene.name) && scene.name.empty())
     meta.fail_at("name", "must not be empty");
   read_frame(
-      Section(origin, root, "frame",
-              {"preset", "masses_kg", "stiffnesses_n_per_m", "damping", "stiffness_damping_s",
-               "rayleigh_zeta", "rayleigh_modes", "modal_zeta", "stiffness_scale",
-               "stiffness_scales"}),
+      Section(origin, root, "frame", kFrameKeys),
       &p.frame);
-  const Section device(origin, root, "device", {"kind", "floor", "mass_ratio", "mass_kg"});
+  const Section device(origin, root, "device", kDeviceKeys);
   read_device(device, &p.device);
-  read_tmd(Section(origin, root, "tmd",
-                   {"k_n_per_m", "c_ns_per_m", "initial_position_m", "initial_velocity_mps"}),
-           &p.device.tmd);
-  const Section vines(origin, root, "vines",
-                      {"radius_m", "density_kg_m3", "young_pa", "poisson", "wall_young_pa",
-                       "wall_poisson", "beta", "box_length_m", "law", "eps", "v_ref_mps", "tau_s",
-                       "initial_position_m", "initial_velocity_mps"});
+  read_tmd(Section(origin, root, "tmd", kTmdKeys), &p.device.tmd);
+  const Section vines(origin, root, "vines", kVinesKeys);
   read_vines(vines, &p.device.vines);
   // The sphere's radius sets its mass: a device mass as well is a conflict.
   if (p.device.kind == DeviceKind::kVines && vines.has("radius_m") &&
       (device.has("mass_ratio") || device.has("mass_kg")))
     vines.fail_at("radius_m", "sets the particle mass; conflicts with device.mass_ratio / mass_kg");
 
-  const Section record(
-      origin, root, "record",
-      {"path", "format", "units", "dt_s", "column", "scale", "pga_g", "duration_s"});
+  const Section record(origin, root, "record", kRecordKeys);
   if (!record.present())
     fail(origin, nullptr, "record", "missing table: the scene needs a [record]");
   read_record(record, &scene);
-  read_loop(Section(origin, root, "loop",
-                    {"sensor_rate_hz", "contact_rtol", "max_substeps_per_step",
-                     "contact_count_depth_m", "energy_ledger", "floor_peaks", "divergence_limit_m",
-                     "contact_scheme", "bounded_substeps", "scalar"}),
-            &p.loop, &scene.scalar);
+  read_loop(Section(origin, root, "loop", kLoopKeys), &p.loop, &scene.scalar);
 
   // The shared range checks, reported at the offending key's line.
   if (const ParamError e = validate(p); !e.ok()) {
@@ -325,7 +342,7 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
     const toml::node* n = root.at_path(e->key).node();
     fail(origin, n != nullptr ? &n->source() : nullptr, e->key, e->message);
   }
-  read_output(Section(origin, root, "output", {"rate_hz", "timeseries"}), p.loop.sensor_rate_hz,
+  read_output(Section(origin, root, "output", kOutputKeys), p.loop.sensor_rate_hz,
               &scene.output);
   return scene;
 }

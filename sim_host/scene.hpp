@@ -45,6 +45,10 @@ class SceneError : public std::runtime_error {
 // unknown keys, wrong types, bad values are SceneErrors). The record path is left as written; see resolve_record_path.
 Scene load_scene(const std::string& path);
 
+// Whether "table.key" is a key of the scene format (a sweep's keys are
+// checked at load: a typo fails the spec, not every run).
+bool is_scene_key(const std::string& dotted);
+
 // Same, from TOML text (for tests); `origin` names it in messages.
 Scene parse_scene(const std::string& toml_text, const std::string& origin);
 

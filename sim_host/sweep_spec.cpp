@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "host/record.hpp"
@@ -129,11 +130,18 @@ Scaled grid_axis(const std::string& where, const std::string& key, const toml::n
   } else {
     fail(where, key + ": a grid key takes a list of values or a range table");
   }
-  // Union of the numbers, sorted, without duplicates.
+  // Union of the numbers, sorted, without duplicates: equal values (ranges
+  // that share an end) are one run; distinct values closer than 1e-12 would
+  // silently be one run too, and are refused.
   std::sort(numbers.begin(), numbers.end());
-  numbers.erase(std::unique(numbers.begin(), numbers.end(),
-                            [](double a, double b) { return std::fabs(a - b) <= 1e-12 * (1 + std::fabs(a)); }),
-                numbers.end());
+  numbers.erase(std::unique(numbers.begin(), numbers.end()), numbers.end());
+  for (std::size_t i = 1; i < numbers.size(); ++i)
+    if (std::fabs(numbers[i] - numbers[i - 1]) <= 1e-12 * (1 + std::fabs(numbers[i - 1]))) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, ": values %.17g and %.17g are closer than 1e-12 (one run): drop one",
+                    numbers[i - 1], numbers[i]);
+      fail(where, key + msg);
+    }
   for (double x : numbers) {
     KeyValue v;
     v.key = key;
@@ -244,6 +252,7 @@ SweepSpec parse_sweep(const std::string& text, const std::string& path) {
   SweepSpec spec;
   spec.path = path;
   double planned = 0;  // runs of the studies so far
+  std::map<std::string, std::string> names;  // study name -> where it was given
   for (auto&& node : *studies) {
     const toml::table* t = node.as_table();
     if (!t) fail(path, "study: must be a table");
@@ -251,6 +260,8 @@ SweepSpec parse_sweep(const std::string& text, const std::string& path) {
     check_keys(where, *t, {"name", "scene", "group_by", "optimize", "set", "cases", "grid"});
     StudySpec st;
     st.name = t->at_path("name").value_or(std::string("study") + std::to_string(spec.studies.size() + 1));
+    if (const auto [it, fresh] = names.emplace(st.name, where); !fresh)
+      fail(where, "study '" + st.name + "': a second study of that name (the first at " + it->second + ")");
     const auto scene = t->at_path("scene").value<std::string>();
     if (!scene) fail(where, "study '" + st.name + "': needs scene = \"file.toml\"");
     st.scene_path = (fs::path(path).parent_path() / *scene).lexically_normal().string();
@@ -289,14 +300,20 @@ SweepSpec parse_sweep(const std::string& text, const std::string& path) {
           for (KeyValue& v : ax.values) v.text = "scale:" + ax.scale;
         st.grid_axes.push_back(ax.values);
       }
-    // Every key this study sets (fixed, per case, per grid axis) is a scene key.
-    auto check_key = [&](const KeyValue& v) {
+    // Every key this study sets (fixed, per case, per grid axis) is a scene
+    // key, set in one place only (a key in both [study.set] and the grid
+    // would have one value silently win).
+    std::map<std::string, std::string> placed;  // key -> where the study sets it
+    auto check_key = [&](const KeyValue& v, const std::string& in) {
       if (v.key.find('.') == std::string::npos) fail(where, v.key + ": keys are table.key");
+      if (!is_scene_key(v.key)) fail(where, v.key + ": not a scene key (data/scenes/README.md lists them)");
+      const auto [it, fresh] = placed.emplace(v.key, in);
+      if (!fresh && it->second != in) fail(where, v.key + ": set in both " + it->second + " and " + in);
     };
-    for (const KeyValue& v : st.set) check_key(v);
+    for (const KeyValue& v : st.set) check_key(v, "[study.set]");
     for (const auto& c : st.cases)
-      for (const KeyValue& v : c) check_key(v);
-    for (const auto& ax : st.grid_axes) check_key(ax.front());
+      for (const KeyValue& v : c) check_key(v, "[[study.cases]]");
+    for (const auto& ax : st.grid_axes) check_key(ax.front(), "[study.grid]");
     if (!st.group_by.empty()) {
       bool found = false;
       for (const auto& ax : st.grid_axes) found |= ax.front().key == st.group_by;

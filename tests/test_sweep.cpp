@@ -199,6 +199,16 @@ TEST(Sweep, BadSpecsAreRefusedWithTheirKey) {
   refused("[study\n", "TOML syntax error");
   refused("[[study]]\n" + scene + "[study.grid]\nbeta = [1.2]\n", "keys are table.key");
   refused("[[study]]\n" + scene + "[[study.cases]]\npath = \"x\"\n", "keys are table.key");
+  // A typo in a key fails the spec at load, not every run.
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.betta\" = [1.2]\n",
+          "vines.betta: not a scene key");
+  // A key in two places, two studies of one name, values that would merge.
+  refused("[[study]]\n" + scene + "[study.set]\n\"vines.beta\" = 1.3\n[study.grid]\n\"vines.beta\" = [1.2]\n",
+          "vines.beta: set in both [study.set] and [study.grid]");
+  refused("[[study]]\nname = \"a\"\n" + scene + "[[study]]\nname = \"a\"\n" + scene,
+          "study 'a': a second study of that name");
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.beta\" = [1.2, 1.2000000000000002, 1.3]\n",
+          "vines.beta: values 1.2 and 1.2000000000000002 are closer than 1e-12");
   // A grid value the scene refuses fails that run with the scene's message.
   const fs::path f = dir / "bad_beta.toml";
   std::ofstream(f) << "[[study]]\n" << scene << "[study.grid]\n\"vines.beta\" = [0.9, 1.35]\n";
