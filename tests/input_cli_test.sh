@@ -80,6 +80,15 @@ if ! grep -q 'vines.radius_m: the Hertz contact lasts' "$WORK/sweep/results.csv"
   failed=$((failed + 1))
 fi
 
+# Options that do not apply are usage errors, not ignored.
+KOBE="$GM/kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2"
+expect 2 "--record-dt: $KOBE is read as at2" -- "$VINES" run data/scenes/elcentro_vines.toml --record "$KOBE" --record-dt 0.01
+expect 2 "--record-units: $KOBE is read as at2" -- "$VINES" run data/scenes/elcentro_vines.toml --record "$KOBE" --record-units m/s2
+expect 2 "--record-column: $KOBE is read as at2" -- "$VINES" run data/scenes/elcentro_vines.toml --record "$KOBE" --record-column 2
+expect 2 "--image: a board image: it needs --node qemu:TARGET" -- "$VINES" hil data/scenes/elcentro_vines.toml --image x.elf
+expect 2 "--comp: a hybrid option: it needs --mode hybrid" -- "$VINES" hil data/scenes/elcentro_vines.toml --mode twin --comp poly
+expect 2 "--twin-kappa: a twin option: it needs --mode twin" -- "$VINES" hil data/scenes/elcentro_vines.toml --twin-kappa 3
+
 # A file's bytes in a message are escaped and cut: an escape sequence does
 # not reach the terminal raw, a 1 MB token is not printed whole.
 printf '0 1\n0.01 \033[31mred\033[0m\n' > "$WORK/esc.txt"

@@ -29,7 +29,29 @@ struct HilArgs {
   host::HilOptions opt;
   bool as_json = false;
   bool accept_degraded = false;
+  const CLI::App* cmd = nullptr;  // for the options given (check_options)
 };
+
+// Option groups that belong to one mode (their names, as --help shows them).
+const char* const kTwinGroup = "twin options";
+const char* const kTuningGroup = "twin estimator tuning (docs/twin.md section 4)";
+const char* const kHybridGroup = "hybrid options";
+
+// An option given that does not apply is a usage error, not ignored: another
+// mode's options, --image without a board.
+void check_options(const HilArgs& a) {
+  const host::HilOptions& o = a.opt;
+  for (const CLI::Option* opt : a.cmd->get_options()) {
+    if (opt->count() == 0) continue;
+    const std::string& g = opt->get_group();
+    if ((g == kTwinGroup || g == kTuningGroup) && o.mode != host::HilMode::kTwin)
+      throw CLI::ValidationError(opt->get_name(), "a twin option: it needs --mode twin");
+    if (g == kHybridGroup && o.mode != host::HilMode::kHybrid)
+      throw CLI::ValidationError(opt->get_name(), "a hybrid option: it needs --mode hybrid");
+  }
+  if (a.cmd->count("--image") > 0 && o.node.rfind("qemu:", 0) != 0)
+    throw CLI::ValidationError("--image", "a board image: it needs --node qemu:TARGET");
+}
 
 // The twin's part of the report as text.
 void print_twin(const host::HilTwinReport& t) {
@@ -134,6 +156,7 @@ void print_hil(const host::HilReport& r) {
 }
 
 int hil(const HilArgs& a) {
+  check_options(a);
   const host::Scene scene = host::load_scene(a.scene_path);
   const host::HilReport r = host::run_hil(scene, a.opt);
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
@@ -185,6 +208,7 @@ void add_hil(CLI::App& vines) {
       "window, the top floor's deviation from the clean run within the clean run's peak (docs/link_protocol.md). Exit 0; 3 if a "
       "kind was not survived; 1 if outputs were not finite or the node failed.",
       [a] { return hil(*a); });
+  a->cmd = cmd;
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
   const std::vector<std::string> modes(std::begin(host::kHilModeNames), std::end(host::kHilModeNames));
   cmd->add_option_function<std::string>(
@@ -281,7 +305,7 @@ void add_hil(CLI::App& vines) {
       ->check(number_in(1, 1e6))
       ->group(faults);
 
-  const std::string twin = "twin options";
+  const std::string twin = kTwinGroup;
   const std::vector<std::string> estimators(std::begin(host::kHilEstimatorNames), std::end(host::kHilEstimatorNames));
   cmd->add_option_function<std::string>(
          "--estimator",
@@ -341,7 +365,7 @@ void add_hil(CLI::App& vines) {
       ->group(twin);
 
   // The estimator's tuning (docs/twin.md section 4): defaults from there.
-  const std::string tuning = "twin estimator tuning (docs/twin.md section 4)";
+  const std::string tuning = kTuningGroup;
   host::TwinTuning& tu = opt.tuning;
   const std::pair<const char*, std::pair<double*, const char*>> knobs[] = {
       {"--twin-model-sd", {&tu.model_accel_sd, "process noise: floor acceleration the model misses [m/s^2]"}},
@@ -361,7 +385,7 @@ void add_hil(CLI::App& vines) {
   for (const auto& [name, k] : knobs)
     cmd->add_option(name, *k.first, k.second)->type_name("X")->check(number_in(1e-9, 1e6))->group(tuning);
 
-  const std::string hybrid = "hybrid options";
+  const std::string hybrid = kHybridGroup;
   cmd->add_option("--actuator-hz", opt.actuator_hz, "natural frequency of the actuator, a second-order servo (Hz, default 20)")
       ->type_name("F")
       ->check(number_in(0.1, 1e4))

@@ -29,14 +29,38 @@ struct RunArgs {
   std::string record_format = "auto", record_units = "g";
   host::RunOptions opt;
   const CLI::Option* out = nullptr;  // --out, given or not
+  const CLI::App* cmd = nullptr;     // the options given (check_reading)
   bool accept_degraded = false;
 };
+
+// How to read the --record file: an option the file's format does not take
+// is a usage error, not ignored (an AT2 header gives its time step and units,
+// only a time/accel file has columns to pick, only values need a step).
+void check_reading(const RunArgs& a) {
+  const std::string& path = a.opt.record_override;
+  const bool dt = a.cmd->count("--record-dt") > 0, units = a.cmd->count("--record-units") > 0,
+             column = a.cmd->count("--record-column") > 0;
+  if (path.empty() || !(dt || units || column)) return;
+  hal::RecordFormat f = a.opt.record_reading.format;
+  if (f == hal::RecordFormat::kAuto) f = hal::detect_record_format(path);
+  std::string name;
+  for (const auto& [n, v] : host::kRecordFormats)
+    if (v == f) name = n;
+  const std::string read_as = path + " is read as " + name;
+  if (dt && f != hal::RecordFormat::kAccel)
+    throw CLI::ValidationError("--record-dt", read_as + ": its time step comes from the file");
+  if (units && f == hal::RecordFormat::kAt2)
+    throw CLI::ValidationError("--record-units", read_as + ": its header gives its units");
+  if (column && f != hal::RecordFormat::kTimeAccel)
+    throw CLI::ValidationError("--record-column", read_as + ": only a time/accel file has columns to pick");
+}
 
 int run(RunArgs a) {
   using namespace vines::host;
   RunOptions& opt = a.opt;
   opt.record_reading.format = *host::named(host::kRecordFormats, a.record_format);  // checked by CLI11
   opt.record_reading.units = *host::named(host::kRecordUnits, a.record_units);
+  check_reading(a);
   const Scene scene = load_scene(a.scene_path);
   if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(scene.name);
   const RunReport r = run_scene(scene, opt);
@@ -79,6 +103,7 @@ void add_run(CLI::App& vines) {
                               "on the same record too and x_r, E_r are reported. Writes DIR/summary.json and "
                               "DIR/timeseries.csv.",
                               "", [a] { return run(*a); });
+  a->cmd = cmd;
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
   cmd->add_option("--record", a->opt.record_override,
                   "use this ground-motion file instead of the scene's [record] path; its format is read from "
