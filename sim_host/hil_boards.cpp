@@ -41,10 +41,18 @@ std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) 
   const std::string path = !opt.image.empty() ? opt.image
                                               : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +
                                                     "/firmware/app/vines_node_" + dev + ".elf";
-  std::ifstream f(path);
+  std::ifstream f(path, std::ios::binary);
   if (!f)
     throw std::runtime_error("--node " + opt.node + ": no board image " + path + " (build it: cmake --preset " +
                              b.target + " && cmake --build --preset " + b.target + ")");
+  // A 32-bit little-endian ARM ELF executable (e_machine 40), or QEMU would
+  // fail on it with a register dump that names nothing.
+  unsigned char h[20] = {};
+  f.read(reinterpret_cast<char*>(h), sizeof h);
+  const bool elf = f.gcount() == sizeof h && h[0] == 0x7f && h[1] == 'E' && h[2] == 'L' && h[3] == 'F';
+  if (!elf || h[4] != 1 || h[5] != 1 || h[16] != 2 || h[18] != 40)
+    throw std::runtime_error("--image " + path + ": not a board image (a 32-bit ARM ELF executable, as " +
+                             b.target + "'s build makes)");
   return path;
 }
 

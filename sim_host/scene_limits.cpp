@@ -26,7 +26,7 @@ std::string size_key(const SceneParams& p) {
 }  // namespace
 
 std::optional<LimitError> check_contact_scales(const SceneParams& p) {
-  if (p.device.kind != DeviceKind::kVines || p.device.vines.law == ContactLaw::kRestitution) return std::nullopt;
+  if (p.device.kind != DeviceKind::kVines) return std::nullopt;
   // The particle as the model designs it: its mass from the nominal frame's
   // first mode (as build_model), the Hertz prefactor C of the pair.
   const double m_eff1 = reference::host_modes(reference::build_host_frame(undamaged(p.frame))).m_eff[0];
@@ -35,6 +35,18 @@ std::optional<LimitError> check_contact_scales(const SceneParams& p) {
   hertz.law = ContactLaw::kHertz;  // C, radius and mass only: no Kuwabara calibration
   const VinesDesign d = design_vines(hertz, mass, 1.0);
   const VinesParams& v = p.device.vines;
+  // The box's free travel, from beta (or the box's length) and the radius:
+  // finite, and within what a building's device could be.
+  constexpr double kMaxGapM = 1e3;
+  if (!(std::isfinite(d.gap) && d.gap <= kMaxGapM)) {
+    const bool by_box = v.box_length_m != 0.0;
+    return LimitError{by_box ? "vines.box_length_m" : "vines.beta", "free travel beyond 1000 m",
+                      "the sphere's free travel in the box is " + num(d.gap) + " m (" +
+                          (by_box ? "vines.box_length_m " + num(v.box_length_m) : "vines.beta " + num(v.beta)) +
+                          ", radius " + num(d.radius) + " m), beyond the " + num(kMaxGapM) +
+                          " m a building's device could have"};
+  }
+  if (v.law == ContactLaw::kRestitution) return std::nullopt;
   const double speed = std::max({v.v_ref_mps, std::fabs(v.initial_velocity_mps), kMinRepresentativeSpeed});
   const double t_c = contact::hertz_duration(d.mass, d.c, speed);
   const double overlap = contact::hertz_max_overlap(d.mass, d.c, speed);

@@ -89,6 +89,10 @@ expect 2 "--image: a board image: it needs --node qemu:TARGET" -- "$VINES" hil d
 expect 2 "--comp: a hybrid option: it needs --mode hybrid" -- "$VINES" hil data/scenes/elcentro_vines.toml --mode twin --comp poly
 expect 2 "--twin-kappa: a twin option: it needs --mode twin" -- "$VINES" hil data/scenes/elcentro_vines.toml --twin-kappa 3
 
+# A board image that is not one is named, not left to QEMU's register dump.
+echo "not an image" > "$WORK/bad.elf"
+expect 1 "--image $WORK/bad.elf: not a board image" -- "$VINES" hil data/scenes/elcentro_vines.toml --node qemu:cortex-m7 --image "$WORK/bad.elf"
+
 # A file's bytes in a message are escaped and cut: an escape sequence does
 # not reach the terminal raw, a 1 MB token is not printed whole.
 printf '0 1\n0.01 \033[31mred\033[0m\n' > "$WORK/esc.txt"

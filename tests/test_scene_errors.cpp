@@ -75,6 +75,13 @@ TEST(SceneError, VinesValues) {
                  {"bad.toml:7:", "vines.law", "\"kuwabara\"", "kuwabarra"});
   expect_refused(kBase + "[vines]\npoisson = 0.5\n", {"vines.poisson"});
   expect_refused(kBase + "[vines]\nv_ref_mps = 0\n", {"vines.v_ref_mps"});
+  // Bounded work whatever the parameters: a reference speed no impact has
+  // is refused at once (1e-300 took 15 s to calibrate, tau 3e52 s).
+  expect_refused(kBase + "[vines]\nv_ref_mps = 1e-300\n", {"bad.toml:7:", "vines.v_ref_mps", "[1e-4, 1000]"});
+  // A derived value out of range names the inputs it comes from (beta
+  // 1e308: the free travel overflowed to null fields, status ok).
+  expect_refused(kBase + "[vines]\nbeta = 1e308\n",
+                 {"bad.toml:7:", "vines.beta", "free travel", "vines.beta 1e+308", "radius"});
 }
 
 TEST(SceneError, ZeroMeansDefaultKeys) {

@@ -252,7 +252,8 @@ void add_hil(CLI::App& vines) {
          "double, instructions counted; build the preset first), or the path of a node program")
       ->type_name("N");
   cmd->add_option("--image", opt.image,
-                  "the board image to run (default: build/TARGET/firmware/app/vines_node_DEVICE.elf)")
+                  "the board image to run (default: build/TARGET/firmware/app/vines_node_DEVICE.elf; in twin mode with "
+                  "the estimator, vines_node_twin.elf)")
       ->type_name("ELF");
   cmd->add_option("--budget-ticks", opt.budget_ticks,
                   "the node's deadline budget in its counter ticks (ns on the host, 25 MHz on a board; default one "

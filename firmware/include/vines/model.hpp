@@ -367,7 +367,10 @@ ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     const VinesParams& vp = p.device.vines;
     const VinesDesign d = design_vines(vp, device_mass, floor_mass);
-    if (!d.ok) return {"vines.eps", "tau could not be calibrated for this eps and v_ref"};
+    if (!d.ok)
+      return {"vines.eps",
+              "tau could not be calibrated for this eps and v_ref with these masses (the sphere's: "
+              "device.mass_ratio or mass_kg, vines.radius_m; its floor's: frame.masses_kg)"};
     if (!(d.gap > 0.0)) return {"vines.box_length_m", "must be longer than the sphere diameter"};
     auto& dm = md.dev;
     dm.design = d;
