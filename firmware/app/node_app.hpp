@@ -133,4 +133,15 @@ int serve(link::Node<Plant, PortSink>& node, const PortSink& sink, const ServeOp
   return 1;
 }
 
+// A board's main(): the stack painted for its high-water mark, the port
+// opened, the node served in lock step until STOP (0) or 10 s of silence (1).
+template <class Plant>
+int board_main(link::Node<Plant, PortSink>& node, const PortSink& sink) {
+  hal::stack_paint();
+  hal::port_init();
+  ServeOptions o;
+  o.idle_limit_ms = 10000;
+  return serve(node, sink, o);
+}
+
 }  // namespace vines::app

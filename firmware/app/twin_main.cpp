@@ -24,10 +24,4 @@ vines::link::Node<Timed, vines::app::PortSink> g_node(&g_timed, &g_sink);
 
 }  // namespace
 
-int main() {
-  vines::hal::stack_paint();
-  vines::hal::port_init();
-  vines::app::ServeOptions o;
-  o.idle_limit_ms = 10000;
-  return vines::app::serve(g_node, g_sink, o);
-}
+int main() { return vines::app::board_main(g_node, g_sink); }
