@@ -109,18 +109,18 @@ std::string plan_fingerprint(const SweepSpec& spec, const std::vector<RunPlan>& 
   // Each study's settings, its scene file (wherever the sweep is started from) and the
   // scene as parsed (toml++ prints it in a fixed order).
   for (const StudySpec& st : spec.studies) {
+    const toml::table table = read_scene_table(st.scene_path);
     std::ostringstream scene;
-    scene << read_scene_table(st.scene_path);
+    scene << table;
     const std::string where = std::filesystem::weakly_canonical(st.scene_path).string();
     for (const std::string& s : {st.name, where, st.group_by, st.optimize, scene.str()}) d.add(s);
     for (const KeyValue& v : st.set) d.add(v.key + "=" + v.label());
     // Every record file the study reads, by its bytes: a record changed
     // between a sweep and its resume would mix old and new runs.
     std::vector<std::string> records;
-    if (!st.scene_toml.empty() || std::filesystem::exists(st.scene_path)) {
-      const toml::table t = st.scene_toml.empty() ? read_scene_table(st.scene_path) : toml::parse(st.scene_toml);
-      if (const auto* path = t["record"]["path"].as_string()) records.push_back(path->get());
-    }
+    const toml::table own = st.scene_toml.empty() ? toml::table{} : parse_scene_table(st.scene_toml, st.scene_path);
+    if (const auto* path = (st.scene_toml.empty() ? table : own)["record"]["path"].as_string())
+      records.push_back(path->get());
     auto files = [&](const std::vector<KeyValue>& vs) {
       for (const KeyValue& v : vs)
         if (v.record_file) records.push_back(v.text);

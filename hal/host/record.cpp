@@ -316,24 +316,18 @@ void check_extent(const std::string& path, std::size_t points, double dt, double
 // first rising by one step: a time column, which would be read as
 // accelerations.
 void refuse_time_column(const std::vector<Line>& lines, const std::string& path) {
-  std::vector<double> first;
-  std::size_t columns = 0;
-  for (const Line& l : lines) {
-    const auto toks = tokens(l.text, true);
-    if (toks.empty()) continue;
-    if (columns == 0) columns = toks.size();
-    if (toks.size() != columns || columns < 2) return;
-    std::string t(toks[0]);
-    double v = 0;
-    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return;
-    first.push_back(v);
+  Table t;
+  try {
+    t = parse_table(lines, path);
+  } catch (const RecordError&) {
+    return;  // ragged rows or not numbers: not a table (parse_accel says what is wrong)
   }
-  if (first.size() < 3) return;
-  const double step = first[1] - first[0];
+  if (t.columns < 2 || t.rows.size() < 3) return;
+  const double step = t.rows[1][0] - t.rows[0][0];
   if (!(step > 0)) return;
-  for (std::size_t i = 1; i < first.size(); ++i)
-    if (std::abs(first[i] - first[i - 1] - step) > 1e-6 * std::max(step, std::abs(first[i]))) return;
+  for (std::size_t i = 1; i < t.rows.size(); ++i)
+    if (std::abs(t.rows[i][0] - t.rows[i - 1][0] - step) > 1e-6 * std::max(step, std::abs(t.rows[i][0]))) return;
+  const std::size_t columns = t.columns;
   fail(path, "format accel, but every row has " + std::to_string(columns) +
                  " columns and the first rises by " + fmt(step) +
                  " each row: a time column (use format \"time-accel\", or \"auto\")");

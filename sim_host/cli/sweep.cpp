@@ -97,7 +97,7 @@ int sweep(SweepArgs a) {
     opt.out_dir = "out/" + safe_file_name(std::filesystem::path(a.spec_path).stem().string());
   // The folder is claimed (and locked) before the runs by rank 0, which
   // writes it; its refusal stops every rank alike, none is left waiting.
-  const std::string fingerprint = plan_fingerprint(spec, plan);
+  const std::string fingerprint = mpi.rank() == 0 ? plan_fingerprint(spec, plan) : std::string();
   std::optional<OutputDir> out;
   std::exception_ptr refused;
   if (mpi.rank() == 0) {
