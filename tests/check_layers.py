@@ -18,6 +18,12 @@ Layers (see the README of each folder):
               tests, tools
 No layer above may include host code (sim_host/, hal/host/, host/...), and
 nothing reaches out of its folder with "../". Standard library only.
+
+Inside sim_host/, the rooms (sim_host/README.md), each including only its own
+files and the rooms below it; no source file outside a room, no room of more
+than 20 source files:
+  io < scene < engines < run < reference < studies, hil (hil/, hil/link/,
+  hil/modes/: one bench) < python < cli
 """
 import os
 import re
@@ -47,6 +53,45 @@ LAYERS = [
     ("core tests", "tests/core", ["firmware/include", "tests/fuzz"], core_test_angle),
 ]
 HOST_PREFIXES = ("sim_host/", "hal/host/", "host/")
+
+# sim_host's rooms, bottom up: room -> the rooms it may include besides itself.
+_BELOW = ["io", "scene", "engines", "run", "reference"]
+_HIL = ["hil", "hil/link", "hil/modes"]
+HOST_ROOMS = {"io": [], "scene": _BELOW[:1], "engines": _BELOW[:2], "run": _BELOW[:3],
+              "reference": _BELOW[:4], "studies": _BELOW}
+HOST_ROOMS.update({room: _BELOW + _HIL for room in _HIL})
+HOST_ROOMS["python"] = _BELOW + _HIL + ["studies"]
+HOST_ROOMS["cli"] = _BELOW + _HIL + ["studies", "python"]
+ROOM_MAX_FILES = 20
+SOURCE = (".hpp", ".h", ".cpp", ".c", ".in")
+
+
+def check_rooms(root):
+    """sim_host's rooms: every source file in one, includes only downward, none too large."""
+    problems, top = [], os.path.join(root, "sim_host")
+    for dirpath, _, names in os.walk(top):
+        rel = os.path.relpath(dirpath, top).replace(os.sep, "/")
+        sources = [n for n in sorted(names) if n.endswith(SOURCE)]
+        room = rel.split("/")[0] if rel.split("/")[0] not in ("hil",) else rel
+        if room == "python" or rel.startswith("python/"):
+            room = "python"
+        if sources and room not in HOST_ROOMS:
+            problems += [f"sim_host/{rel}/{n}: not in a room of sim_host/README.md" for n in sources]
+            continue
+        if len(sources) > ROOM_MAX_FILES:
+            problems.append(f"sim_host/{rel}: {len(sources)} source files (a room holds at most {ROOM_MAX_FILES})")
+        for name in sources:
+            path = os.path.join(dirpath, name)
+            with open(path, encoding="utf-8", errors="replace") as f:
+                for n, line in enumerate(f, 1):
+                    m = INCLUDE.match(line)
+                    if not m or not m.group(2).startswith("sim_host/"):
+                        continue
+                    target = os.path.dirname(m.group(2)[len("sim_host/"):])
+                    if target != room and target not in HOST_ROOMS[room]:
+                        problems.append(f"sim_host/{rel}/{name}:{n}: #include \"{m.group(2)}\": "
+                                        f"room {room} may include only {', '.join(HOST_ROOMS[room]) or 'itself'}")
+    return problems
 
 
 def check_file(root, layer, folder, roots, angle_ok, path):
@@ -89,6 +134,7 @@ def main(argv):
                 if name.endswith((".hpp", ".h", ".cpp", ".c")):
                     files += 1
                     problems += check_file(root, layer, folder, roots, angle_ok, os.path.join(dirpath, name))
+    problems += check_rooms(root)
     for p in problems:
         print(p)
     print(f"check_layers: {files} files, {len(problems)} problems")

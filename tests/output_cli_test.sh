@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The commands' writes (sim_host/output.hpp) from the command line: a write
+# The commands' writes (sim_host/io/output.hpp) from the command line: a write
 # that fails (file-size limit: EFBIG, as a full disk) exits nonzero naming the
 # file and the reason, leaves no partial or temporary file and keeps the
 # previous results; a run owns its folder (stale files removed, foreign files

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A sweep's resume proves its log (sim_host/sweep_log.hpp), under random
+"""A sweep's resume proves its log (sim_host/studies/sweep_log.hpp), under random
 kill points and random damage to DIR/runs.jsonl: every `vines sweep --resume`
 either gives the uninterrupted sweep's results.csv, byte for byte, or is
 refused (exit 1) with a message naming the log. Anything else fails: a resume

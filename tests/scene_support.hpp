@@ -8,7 +8,7 @@
 #include <initializer_list>
 #include <string>
 
-#include "sim_host/scene.hpp"
+#include "sim_host/scene/scene.hpp"
 
 namespace vines::scene_test {
 

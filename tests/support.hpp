@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "host/record.hpp"
-#include "sim_host/engine.hpp"
+#include "sim_host/engines/engine.hpp"
 #include "vines/frame_presets.hpp"
 
 namespace vines::test {

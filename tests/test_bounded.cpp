@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim_host/scene.hpp"
+#include "sim_host/scene/scene.hpp"
 #include "support.hpp"
 #include "vines/link/config.hpp"
 #include "vines/substep_bounded.hpp"

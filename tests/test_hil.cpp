@@ -12,7 +12,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
-#include "sim_host/hil.hpp"
+#include "sim_host/hil/hil.hpp"
 
 namespace vines::host {
 namespace {

@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/hil.hpp"
-#include "sim_host/hil_child.hpp"
+#include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/child.hpp"
+#include "vines/frame_presets.hpp"
 #include "vines/link/ats.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"
-#include "vines/frame_presets.hpp"
 
 namespace vines::host {
 namespace {

@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/engine.hpp"
-#include "sim_host/scene.hpp"
+#include "model_image_support.hpp"
+#include "sim_host/engines/engine.hpp"
+#include "sim_host/scene/scene.hpp"
 #include "support.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
-#include "model_image_support.hpp"
 
 namespace vines {
 namespace {

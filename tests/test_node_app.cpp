@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "firmware/app/node_app.hpp"
-#include "sim_host/build_engine.hpp"
-#include "sim_host/hil_plant.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/modes/plant.hpp"
 #include "support.hpp"
 #include "vines/link/model_plant.hpp"
 #include "vines/model_image.hpp"
@@ -90,7 +90,7 @@ std::vector<std::uint8_t> image_of(const SceneParams& p) {
   return out;
 }
 
-// The hybrid frame image the bench sends (sim_host/hil_offline.cpp): the
+// The hybrid frame image the bench sends (sim_host/hil/offline.cpp): the
 // bare frame's modes of scene p at its sensor rate.
 std::vector<std::uint8_t> hybrid_image_of(SceneParams p) {
   p.device.kind = DeviceKind::kNone;

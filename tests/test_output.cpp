@@ -1,4 +1,4 @@
-// sim_host/output.hpp: atomic checked writes, safe folder names, output folders
+// sim_host/io/output.hpp: atomic checked writes, safe folder names, output folders
 // owned by their command.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -19,8 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/csv.hpp"
-#include "sim_host/output.hpp"
+#include "sim_host/io/csv.hpp"
+#include "sim_host/io/output.hpp"
 
 namespace fs = std::filesystem;
 using vines::host::AtomicFile;

@@ -10,8 +10,8 @@
 
 #include "host/record.hpp"
 #include "record_support.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/scene.hpp"
 
 using namespace vines::hal;
 using namespace vines::record_test;

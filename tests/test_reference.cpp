@@ -12,18 +12,19 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim_host/bench.hpp"
-#include "sim_host/reference/frame.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/reference/truth.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/frame.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/bench.hpp"
 #include "support.hpp"
 #include "vines/frame.hpp"
 
 namespace {
 
 using namespace vines;
+using namespace vines::host;
 using namespace vines::host::reference;
 using LD = long double;
 

@@ -141,13 +141,14 @@ TEST(RecordSourceTest, HandsOutSamplesAndAdvancesClockExactly) {
 }
 
 TEST(RecordSourceTest, WorksWithoutClockAndRejectsBadRate) {
-  RecordSource src({1.0, 2.0}, 1000.0);
+  const std::vector<double> samples = {1.0, 2.0};
+  RecordSource src(samples, 1000.0);
   double a = 0.0;
   EXPECT_TRUE(src.next(&a));
   EXPECT_TRUE(src.next(&a));
   EXPECT_EQ(a, 2.0);
   EXPECT_FALSE(src.next(&a));
-  EXPECT_THROW(RecordSource({1.0}, 0.0), std::invalid_argument);
+  EXPECT_THROW(RecordSource(samples, 0.0), std::invalid_argument);
 }
 
 }  // namespace

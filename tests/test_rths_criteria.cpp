@@ -1,4 +1,4 @@
-// The vRTHS benchmark's criteria (sim_host/rths_criteria.hpp) on synthetic
+// The vRTHS benchmark's criteria (sim_host/hil/modes/rths_criteria.hpp) on synthetic
 // signals whose answers are known in closed form: a delayed copy gives its
 // delay, a scaled copy its RMS and peak percentages, a zero reference no
 // percentage at all.
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "sim_host/rths_criteria.hpp"
+#include "sim_host/hil/modes/rths_criteria.hpp"
 
 namespace vines::host::rths {
 namespace {

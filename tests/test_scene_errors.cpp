@@ -8,9 +8,9 @@
 #include <fstream>
 #include <string>
 
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
-#include "sim_host/scene_toml.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/scene/table.hpp"
 
 #include "scene_support.hpp"
 

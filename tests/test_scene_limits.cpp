@@ -12,8 +12,8 @@
 #include <sstream>
 #include <string>
 
-#include "sim_host/scene.hpp"
-#include "sim_host/scene_limits.hpp"
+#include "sim_host/scene/limits.hpp"
+#include "sim_host/scene/scene.hpp"
 
 #include "scene_support.hpp"
 

@@ -1,4 +1,4 @@
-// The run status (sim_host/status.hpp): every result says ok or degraded and
+// The run status (sim_host/run/status.hpp): every result says ok or degraded and
 // why; the bad inputs come out degraded with the right reason and exit
 // status 3 (0 with --accept-degraded); the shipped scenes are ok.
 #include <gtest/gtest.h>
@@ -13,11 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim_host/design.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
-#include "sim_host/status.hpp"
-#include "sim_host/sweep.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/run/status.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/design.hpp"
+#include "sim_host/studies/sweep.hpp"
 
 namespace {
 

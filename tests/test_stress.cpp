@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/engine.hpp"
-#include "sim_host/scene_limits.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
-#include "sim_host/stress.hpp"
+#include "sim_host/engines/engine.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/limits.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/stress.hpp"
 #include "support.hpp"
 
 namespace {

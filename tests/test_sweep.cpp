@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/csv.hpp"
-#include "sim_host/design.hpp"
-#include "sim_host/parallel.hpp"
-#include "sim_host/sweep.hpp"
+#include "sim_host/io/csv.hpp"
+#include "sim_host/studies/design.hpp"
+#include "sim_host/studies/parallel.hpp"
+#include "sim_host/studies/sweep.hpp"
 
 namespace {
 

@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/parallel.hpp"
-#include "sim_host/sweep.hpp"
-#include "sim_host/sweep_log.hpp"
+#include "sim_host/studies/parallel.hpp"
+#include "sim_host/studies/sweep.hpp"
+#include "sim_host/studies/sweep_log.hpp"
 
 namespace {
 

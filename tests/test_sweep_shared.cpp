@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/build_engine.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
-#include "sim_host/sweep.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/sweep.hpp"
 
 namespace {
 

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/build_engine.hpp"
-#include "sim_host/hil.hpp"
-#include "sim_host/hil_twin.hpp"
-#include "sim_host/run.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/modes/twin.hpp"
+#include "sim_host/run/run.hpp"
 #include "vines/link/model_plant.hpp"
 #include "vines/link/twin_plant.hpp"
 #include "vines/twin/estimator.hpp"

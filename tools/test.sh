@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The project's test command. Host: build and run the unit tests (preset
 # release), then a subset of them under the sanitizers (presets debug and
-# sanitize). MCU: for each target (presets cortex-m4f and cortex-m7), build the
+# sanitize). MCU: for each board of hal/mcu/boards.txt (its preset), build the
 # images (the build also proves that the link refuses the heap) and run the
 # MCU tests in QEMU (ctest --preset <target>): the smoke image, the
 # stack-overflow fault, the El Centro VI NES and TMD scenes fed over the UART
@@ -22,7 +22,7 @@ cmake --preset debug
 cmake --build --preset debug -j2 --target sanitize_tests
 ctest --preset sanitize
 
-for target in cortex-m4f cortex-m7; do
+for target in $(grep -oE '^[a-z0-9-]+ *\|' hal/mcu/boards.txt | tr -d ' |'); do
   cmake --preset "$target"
   cmake --build --preset "$target" -j2
   ctest --preset "$target"

@@ -437,15 +437,15 @@ std::vector<double> resample(const Record& record, double rate_hz) {
 
 // ---- RecordSource: samples in order; the clock reads round(k * 1e9 / rate) at sample k ----
 
-RecordSource::RecordSource(std::vector<double> samples_mps2, double rate_hz, SimClock* clock)
-    : samples_(std::move(samples_mps2)), rate_hz_(rate_hz), clock_(clock) {
+RecordSource::RecordSource(const double* samples_mps2, std::size_t n, double rate_hz, SimClock* clock)
+    : samples_(samples_mps2), n_(n), rate_hz_(rate_hz), clock_(clock) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
     throw std::invalid_argument("RecordSource: rate must be positive, got " + fmt(rate_hz));
   }
 }
 
 bool RecordSource::next(double* accel_mps2) {
-  if (pos_ >= samples_.size()) return false;
+  if (pos_ >= n_) return false;
   if (clock_ != nullptr && pos_ > 0) {
     // Advance by the difference of exact tick times so rounding never accumulates.
     auto tick = [this](std::size_t k) {

@@ -100,17 +100,22 @@ class SimClock final : public Clock {
 };
 
 // Feeds resampled samples at the sensor rate; each next() advances the clock
-// by one sensor period (the first sample is at t = 0).
+// by one sensor period (the first sample is at t = 0). A view: the samples
+// (an excitation's, shared by the runs of a study) outlive the source.
 class RecordSource final : public GroundSource {
  public:
-  RecordSource(std::vector<double> samples_mps2, double rate_hz, SimClock* clock = nullptr);
+  RecordSource(const double* samples_mps2, std::size_t n, double rate_hz, SimClock* clock = nullptr);
+  RecordSource(const std::vector<double>& samples_mps2, double rate_hz, SimClock* clock = nullptr)
+      : RecordSource(samples_mps2.data(), samples_mps2.size(), rate_hz, clock) {}
+  RecordSource(std::vector<double>&&, double, SimClock* = nullptr) = delete;  // would dangle
   double rate_hz() const override { return rate_hz_; }
   bool next(double* accel_mps2) override;
-  std::size_t size() const { return samples_.size(); }
+  std::size_t size() const { return n_; }
   std::size_t position() const { return pos_; }
 
  private:
-  std::vector<double> samples_;
+  const double* samples_;
+  std::size_t n_;
   double rate_hz_;
   SimClock* clock_;
   std::size_t pos_ = 0;

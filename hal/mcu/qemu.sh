@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs a bare-metal image on an emulated MPS2 board; the image's exit status
 # (semihosting SYS_EXIT_EXTENDED) is this script's. ctest uses it as
-# CMAKE_CROSSCOMPILING_EMULATOR (cmake/arm-none-eabi-common.cmake).
+# CMAKE_CROSSCOMPILING_EMULATOR (cmake/arm-none-eabi.cmake).
 #   qemu.sh BOARD IMAGE.elf [QEMU_OPTION...]
 # BOARD: mps2-an386 (Cortex-M4F), mps2-an500 (Cortex-M7) or mps2-an385
 # (Cortex-M3, no FPU: the fixed-point image). Extra options go

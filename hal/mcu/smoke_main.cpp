@@ -14,7 +14,7 @@
 
 namespace {
 
-using Scalar = VINES_MCU_SCALAR;  // from the toolchain file (cmake/arm-none-eabi-cortex-*.cmake)
+using Scalar = VINES_MCU_SCALAR;  // from the toolchain file (cmake/arm-none-eabi.cmake)
 using Dev = vines::VinesDevice<vines::ContactLaw::kKuwabara>;
 constexpr int kStories = 10;
 constexpr double kPi = 3.14159265358979323846;

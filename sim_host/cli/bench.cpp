@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "sim_host/bench.hpp"
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/csv.hpp"
+#include "sim_host/io/csv.hpp"
 #include "sim_host/reference/truth.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/bench.hpp"
 #include "vines/params.hpp"
 
 namespace vines::cli {

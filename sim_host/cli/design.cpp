@@ -7,9 +7,9 @@
 #include <utility>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/design.hpp"
-#include "sim_host/output.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/studies/design.hpp"
 
 namespace vines::cli {
 namespace {

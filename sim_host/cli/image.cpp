@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/build_engine.hpp"
-#include "sim_host/names.hpp"
-#include "sim_host/output.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/scene/names.hpp"
+#include "sim_host/scene/scene.hpp"
 #include "vines/model_image.hpp"
 
 namespace vines::cli {

@@ -2,7 +2,7 @@
 #include <memory>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/hil.hpp"
+#include "sim_host/hil/hil.hpp"
 
 namespace vines::cli {
 

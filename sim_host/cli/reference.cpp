@@ -6,9 +6,9 @@
 #include <string>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/output.hpp"
+#include "sim_host/io/output.hpp"
 #include "sim_host/reference/report.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/scene/scene.hpp"
 
 namespace vines::cli {
 namespace {

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/names.hpp"
-#include "sim_host/output.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/names.hpp"
+#include "sim_host/scene/scene.hpp"
 
 namespace vines::cli {
 namespace {

@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/engine.hpp"
-#include "sim_host/names.hpp"
-#include "sim_host/output.hpp"
-#include "sim_host/parallel.hpp"
-#include "sim_host/stress.hpp"
+#include "sim_host/engines/engine.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/scene/names.hpp"
+#include "sim_host/studies/parallel.hpp"
+#include "sim_host/studies/stress.hpp"
 
 namespace vines::cli {
 namespace {

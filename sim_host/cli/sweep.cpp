@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
-#include "sim_host/output.hpp"
-#include "sim_host/parallel.hpp"
-#include "sim_host/printable.hpp"
-#include "sim_host/sweep.hpp"
-#include "sim_host/sweep_log.hpp"
-#include "sim_host/sweep_mpi.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/io/printable.hpp"
+#include "sim_host/studies/parallel.hpp"
+#include "sim_host/studies/sweep.hpp"
+#include "sim_host/studies/sweep_log.hpp"
+#include "sim_host/studies/sweep_mpi.hpp"
 
 namespace vines::cli {
 namespace {
@@ -206,7 +206,7 @@ void add_sweep(CLI::App& vines) {
                               "print their size, memory and time and need --large.",
                               [a] { return sweep(*a); });
   cmd->add_option("SPEC.toml", a->spec_path,
-                  "study spec (format at the top of sim_host/sweep.hpp and in data/studies/README.md)")
+                  "study spec (format at the top of sim_host/studies/sweep.hpp and in data/studies/README.md)")
       ->required();
   a->out = cmd->add_option("--out", a->opt.out_dir,
                            "output folder: new, empty or vines sweep's own (default: out/<spec name>)")

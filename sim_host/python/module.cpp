@@ -19,12 +19,12 @@
 #include <vector>
 
 #include "host/record.hpp"
-#include "sim_host/build_engine.hpp"
-#include "sim_host/names.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
-#include "sim_host/scene_toml.hpp"
-#include "sim_host/sweep.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/names.hpp"
+#include "sim_host/scene/scene.hpp"
+#include "sim_host/scene/table.hpp"
+#include "sim_host/studies/sweep.hpp"
 
 namespace py = pybind11;
 using namespace vines;

@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "sim_host/reference/truth.hpp"
-#include "sim_host/run.hpp"
-#include "sim_host/scene.hpp"
+#include "sim_host/run/run.hpp"
+#include "sim_host/scene/scene.hpp"
 
 namespace vines::host::reference {
 

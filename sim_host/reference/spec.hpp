@@ -3,7 +3,7 @@
 // (design_tmd, design_vines: the same model), the initial state.
 #pragma once
 
-#include "sim_host/reference/frame.hpp"
+#include "sim_host/scene/frame.hpp"
 #include "vines/devices.hpp"
 #include "vines/params.hpp"
 

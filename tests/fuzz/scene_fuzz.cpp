@@ -1,4 +1,4 @@
-// libFuzzer target: the scene parser (sim_host/scene.cpp on Debian's toml++
+// libFuzzer target: the scene parser (sim_host/scene/scene.cpp on Debian's toml++
 // library, as the program runs it) on arbitrary text. A SceneError (a refusal,
 // TOML syntax errors included) is fine; any other exception, crash, sanitizer
 // report or hang is a finding.
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "sim_host/scene.hpp"
+#include "sim_host/scene/scene.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

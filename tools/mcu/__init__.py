@@ -8,10 +8,22 @@ import os
 
 # The repository: tools/mcu/ is two folders down.
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-TARGETS = {  # preset: board, scalar, sensor rate, clock for the sustained-rate figure
-    "cortex-m4f": ("mps2-an386", "float", 1000.0, 168e6),
-    "cortex-m7": ("mps2-an500", "double", 2048.0, 480e6),
-}
+BOARDS_FILE = os.path.join(ROOT, "hal", "mcu", "boards.txt")
+
+
+def read_boards(path=BOARDS_FILE):
+    """The board table: preset -> (QEMU machine, scalar, sensor rate, clock for the sustained-rate figure)."""
+    boards = {}
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            if line.startswith("#") or "|" not in line:
+                continue
+            target, machine, scalar, _flags, rate, clock, _tol, _budget = (x.strip() for x in line.split("|"))
+            boards[target] = (machine, scalar, float(rate), float(clock))
+    return boards
+
+
+TARGETS = read_boards()
 MARGIN = 1.5  # the step must fit in 2/3 of the period
 IMAGES = ("none", "tmd", "vines", "twin")  # vines_node_IMAGE.elf: a device's, or the twin estimator's
 KINDS = ("scene", "records", "ics", "tmd", "bare", "twin_vines", "twin_tmd", "twin_bare")

@@ -7,7 +7,7 @@ program, with scenes, records and results as Python objects and numpy arrays.
     print(result.x_r, result.E_r, result.x.shape)
 
 Scene, Record, run, sweep, Loop (stepping sample by sample), samples, modal:
-README.md, section "Python".
+docs/python.md.
 
 Every check and message is the command line's: a bad scene raises
 vines.SceneError (a ValueError) naming the key, a bad record

@@ -88,7 +88,7 @@ class ModelPlant {
     else vines::step(*model_, *data_, static_cast<S>(a1));
   }
 
-  // What the host node's plant reads (sim_host/hil_plant.cpp), from the same
+  // What the host node's plant reads (sim_host/hil/modes/plant.cpp), from the same
   // core functions.
   void read(Telemetry* t) {
     if (hybrid_mode_) {

@@ -3,7 +3,7 @@
 // image the bench designed, its outputs as telemetry. It is the whole plant
 // of the boards' twin image (firmware/app/twin_main.cpp: a monitoring node
 // holds no simulation model, whatever the building's device) and the host's
-// in that mode (sim_host/hil_plant.cpp), so the same code runs on either.
+// in that mode (sim_host/hil/modes/plant.cpp), so the same code runs on either.
 #pragma once
 
 #include <cmath>

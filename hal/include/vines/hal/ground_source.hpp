@@ -1,6 +1,7 @@
 // HAL facade: where ground-acceleration samples come from, and what time it is.
-// The firmware loop only sees these two interfaces; each build picks a backend
-// (host: record files and a simulated clock; MCU: UART and a hardware timer).
+// The loop is fed through these two interfaces; each build picks a backend
+// (host: record files and a simulated clock, every host run fed by
+// sim_host/run/drive.hpp; MCU: the link's frames and a hardware timer).
 // No virtual destructors: a deleting destructor would drag operator delete
 // (the heap) into the MCU image. Owners destroy concrete types.
 #pragma once

@@ -1,0 +1,113 @@
+// Host access to one compiled instance of the firmware core. The core is a set
+// of templates over (scalar, story count, device); an Engine hides which one a
+// scene needs behind a small virtual interface so that host programs can pick
+// it at run time. Each instance lives in its own translation unit, compiled
+// with the firmware's flags (no exceptions, no RTTI).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim_host/scene/scalar.hpp"
+#include "vines/data.hpp"
+#include "vines/params.hpp"
+#include "vines/validate.hpp"
+
+namespace vines::host {
+
+using FloorArray = std::array<double, kMaxStories>;
+
+// The outputs of one step, in double.
+struct Snapshot {
+  double t = 0, ag = 0;
+  FloorArray x{}, v{}, acc{}, drift{};  // relative disp./vel., absolute acc., story drift
+  double elastic_energy = 0;            // E_e so far [J s]
+  // VI NES
+  double particle_x = 0, particle_v = 0;  // centre relative to ground, from the box centre at rest
+  double wall_left = 0, wall_right = 0;   // where the particle centre touches each wall
+  double contact_force = 0;               // on the particle, positive to the right
+  int mode = 0;                           // vines::Mode
+  // TMD
+  double tmd_x = 0, tmd_v = 0;
+};
+
+// Everything a run summary reports that the model knows.
+struct ModelInfo {
+  int stories = 0;
+  FloorArray frequency_hz{}, zeta{}, gamma{}, m_eff{};
+  std::array<FloorArray, kMaxStories> mode_shapes{};  // mode_shapes[j][i]: floor i of mode j
+  double total_mass = 0;
+  double sensor_period = 0;
+  int device_floor = 0;  // 1-based
+  TmdDesign tmd;
+  VinesDesign vines;
+};
+
+struct RunTotals {
+  FloorArray peak_x{}, peak_drift{};
+  double peak_top = 0, t_peak_top = 0;
+  double peak_top_velocity = 0;
+  double elastic_energy = 0, strain_increments = 0;
+  double max_overlap = 0;
+  Ledger ledger;
+  Counters count;
+};
+
+// What the loop holds after a step, cheap to read every step (no outputs
+// computed): counters, ledger, and the VI NES particle against the walls.
+struct Probe {
+  Counters count;
+  Ledger ledger;
+  double peak_top = 0;  // running peak of the top floor [m]
+  int mode = 0;         // vines::Mode (VI NES)
+  double overlap = 0;   // how far the particle is past the nearer wall now [m] (< 0: still short of it)
+};
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  // Builds the model; the parameters must fit this engine (see make_engine).
+  virtual ParamError build(const SceneParams& p) = 0;
+  // Gives the built model the initial conditions of p (vines.initial_*,
+  // tmd.initial_*; vines::set_initial_conditions): the model is then, bit
+  // for bit, the one build(p) makes when p differs from the built parameters
+  // in nothing else. Call init() after it.
+  virtual ParamError set_initial_conditions(const SceneParams& p) = 0;
+  // The model's image (vines/model_image.hpp), after build() or load_image().
+  virtual std::vector<std::uint8_t> model_image() const = 0;
+  // Loads a model image in place of building: empty on success, after which
+  // init/step/run work as after build(); else why it was refused (the model
+  // held before is kept). An image carries no modal report: info() then has
+  // stories, sensor period, device floor and design, but zero frequencies,
+  // damping ratios, participation, effective masses, mode shapes and mass.
+  virtual std::string load_image(const std::uint8_t* p, std::size_t n) = 0;
+  // What the model knows (partial after load_image, see there).
+  virtual ModelInfo info() const = 0;
+  virtual void init(double a0) = 0;
+  virtual void step(double a1) = 0;
+  // step() for each of n samples in turn: one call for a whole record (the
+  // loop then runs inside the instance, with no call per sample).
+  virtual void run(const double* a, std::size_t n) = 0;
+  virtual Snapshot snapshot() const = 0;
+  virtual RunTotals totals() const = 0;
+  virtual Probe probe() const = 0;
+};
+
+// The engine for a scene's story count, device and law, or nullptr if this
+// build does not include it (see VINES_STORY_COUNTS, VINES_STRESS_STORY_COUNTS).
+std::unique_ptr<Engine> make_engine(const SceneParams& p, Scalar scalar);
+
+// Story counts with an engine for this scalar and device kind.
+std::vector<int> compiled_frames(Scalar scalar, DeviceKind kind);
+
+// The story counts compiled into this build and what each has, for messages.
+std::string compiled_story_counts();
+
+// Why make_engine(p, scalar) gave nullptr, and how to reconfigure.
+std::string missing_engine(const SceneParams& p, Scalar scalar);
+
+}  // namespace vines::host

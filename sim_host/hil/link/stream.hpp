@@ -1,0 +1,21 @@
+// The run itself: the record streamed to the node, paced on the wall clock
+// (--realtime) or in lock step on the virtual clock, with the planned faults
+// put on the link (frames dropped, corrupted, duplicated, reordered, late,
+// stalled, non-finite samples, node restarts), and the node's answers kept.
+#pragma once
+
+#include <vector>
+
+#include "sim_host/hil/bench.hpp"
+#include "sim_host/hil/faults.hpp"
+#include "sim_host/hil/modes/modes.hpp"
+#include "sim_host/hil/record.hpp"
+
+namespace vines::host {
+
+// Runs the bench from its first sample to STOP. Fills each event's node life,
+// link sequence numbers and (restart) detection. Throws naming the node if
+// it fails or does not answer within --timeout.
+HilRecord stream(const Bench& b, BenchMode& mode, std::vector<FaultEvent>* events);
+
+}  // namespace vines::host

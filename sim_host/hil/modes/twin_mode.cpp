@@ -1,0 +1,208 @@
+// The bench's twin mode: the node is fed the measured building's floor
+// accelerations (hil_twin.hpp); its estimates are held against the truth.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "sim_host/hil/modes/modes.hpp"
+
+namespace vines::host {
+namespace {
+
+using link::Telemetry;
+
+// The estimator's spring factors as they come in (one a step, in turn): each
+// held from its last telemetry.
+struct Factors {
+  explicit Factors(int np) : eta(static_cast<std::size_t>(np), 1.0), sd(static_cast<std::size_t>(np), 0.0) {}
+  void take(const Telemetry& t) {
+    if (t.est_index < eta.size()) eta[t.est_index] = t.est_eta, sd[t.est_index] = t.est_sd;
+  }
+  std::vector<double> eta, sd;
+};
+
+// Robust sd of a series (1.4826 x its median absolute value).
+double robust_sd(std::vector<double> v) {
+  for (double& x : v) x = std::fabs(x);
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return 1.4826 * v[v.size() / 2];
+}
+
+class TwinMode : public BenchMode {
+ public:
+  explicit TwinMode(const Bench& b) : b_(b), tb_(b.twin), estimator_(b.cfg.estimator == link::TwinEstimator::kKalman) {}
+
+  double aux(long long k, const HilRecord&) const override { return tb_.top[static_cast<std::size_t>(k)]; }
+  int floors(long long k, double* y) const override {
+    if (!estimator_) return 0;
+    const std::vector<double>& v = tb_.y[static_cast<std::size_t>(k)];
+    std::copy(v.begin(), v.end(), y);
+    return static_cast<int>(v.size());
+  }
+
+  void report(const HilRecord& rec, const std::vector<Telemetry>&, HilReport* r) const override {
+    HilTwinReport tw;
+    residual(rec, &tw);
+    const TwinTruth& tr = tb_.truth;
+    tw.estimator = estimator_ ? "kalman" : "none";
+    tw.truth = tr.path;
+    tw.truth_story_scales = tr.story_scale;
+    tw.sensors = tb_.sensors;
+    tw.noise_sd_mps2 = tb_.noise_sd;
+    tw.strong_motion_start_s = tb_.strong_motion_start_s;
+    if (estimator_) estimates(rec, &tw);
+    r->twin = tw;
+  }
+
+  // Per step: the truth's roof, each spring's factor and sd (held), the
+  // story in alarm, the truth's device force.
+  CsvColumns csv_columns(const HilRecord& rec) const override {
+    CsvColumns c;
+    const int np = params();
+    c.names.push_back("x_top_truth_m");
+    c.names.push_back("device_force_truth_n");
+    if (!estimator_) {
+      for (long long k = 0; k < rec.samples; ++k)
+        c.rows.push_back({tb_.truth.roof_x[static_cast<std::size_t>(k)], tb_.truth.device_force[static_cast<std::size_t>(k)]});
+      return c;
+    }
+    for (int j = 0; j < np; ++j) c.names.push_back("eta_" + param_name(j));
+    for (int j = 0; j < np; ++j) c.names.push_back("eta_sd_" + param_name(j));
+    c.names.push_back("alarm_story");
+    Factors f(np);
+    int alarm = 0;
+    for (long long k = 0; k < rec.samples; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (rec.got[i]) f.take(rec.tel[i]), alarm = rec.tel[i].alarm_story;
+      std::vector<double> row = {tb_.truth.roof_x[i], tb_.truth.device_force[i]};
+      row.insert(row.end(), f.eta.begin(), f.eta.end());
+      row.insert(row.end(), f.sd.begin(), f.sd.end());
+      row.push_back(alarm);
+      c.rows.push_back(std::move(row));
+    }
+    return c;
+  }
+
+ private:
+  // The estimator's parameters: the stories, then the TMD's spring or the
+  // VI NES floor's mass.
+  int params() const { return stories() + (device() == DeviceKind::kNone ? 0 : 1); }
+  int stories() const { return b_.scene.params.frame.stories; }
+  DeviceKind device() const { return b_.scene.params.device.kind; }
+  std::string param_name(int j) const {
+    return j < stories() ? std::to_string(j + 1) : device() == DeviceKind::kTmd ? "tmd" : "device_floor_mass";
+  }
+
+  // The top floor's measured-minus-twin residual, its alarms, the drift
+  // alarms' stories (both estimators).
+  void residual(const HilRecord& rec, HilTwinReport* tw) const {
+    double ss = 0;
+    long long used = 0;
+    std::uint64_t stories = 0;
+    for (long long k = 0; k < rec.samples; ++k) {
+      if (!rec.got[k]) continue;
+      const Telemetry& t = rec.tel[k];
+      if (!(t.flags & link::kAuxMissing))
+        ss += t.aux * t.aux, ++used, tw->residual_max_mps2 = std::max(tw->residual_max_mps2, std::fabs(t.aux));
+      if (t.flags & link::kResidualAlarm) {
+        ++tw->residual_alarm_steps;
+        if (!tw->first_residual_alarm_s) tw->first_residual_alarm_s = static_cast<double>(k) * b_.h;
+      }
+      if (t.flags & link::kDriftAlarm) {
+        ++tw->drift_alarm_steps;
+        stories |= t.drift_alarms;
+        if (!tw->first_drift_alarm_s) tw->first_drift_alarm_s = static_cast<double>(k) * b_.h;
+      }
+    }
+    for (int i = 0; i < b_.scene.params.frame.stories; ++i)
+      if (stories >> i & 1) tw->stories_alarmed.push_back(i + 1);
+    tw->truth_stiffness_scale = b_.opt.truth_stiffness_scale;
+    tw->residual_rms_mps2 = used ? std::sqrt(ss / static_cast<double>(used)) : 0.0;
+    tw->residual_limit_mps2 = b_.opt.residual_limit_mps2;
+    tw->drift_limit_m = b_.opt.drift_limit_m;
+  }
+
+  // The estimator's decision and factors, the roof against the truth, the
+  // device's health.
+  void estimates(const HilRecord& rec, HilTwinReport* tw) const {
+    const int n = b_.scene.params.frame.stories, np = params();
+    Factors f(np);
+    double se = 0, st = 0;
+    bool device_alarm = false;
+    const Telemetry* last = nullptr;
+    for (long long k = 0; k < rec.samples; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (!rec.got[i]) continue;
+      const Telemetry& t = rec.tel[i];
+      f.take(t);
+      last = &t;
+      const double truth = tb_.truth.roof_x[i], e = t.x[n - 1] - truth;
+      se += e * e, st += truth * truth;
+      if ((t.flags & link::kDamage) && !tw->detect_time_s) tw->detect_time_s = static_cast<double>(k) * b_.h;
+      device_alarm = device_alarm || (t.flags & link::kDeviceAlarm);
+    }
+    if (st > 0) tw->roof_displacement_nrmse = std::sqrt(se / st);
+    tw->roof_displacement_sd_m = tb_.design.roof_sd_m;
+    tw->eta_k.assign(f.eta.begin(), f.eta.begin() + n);
+    tw->eta_k_sd.assign(f.sd.begin(), f.sd.begin() + n);
+    tw->detected = tw->detect_time_s.has_value();
+    if (tw->detected && last && last->alarm_story > 0) {
+      tw->story = last->alarm_story;
+      tw->size = 1.0 - f.eta[static_cast<std::size_t>(*tw->story - 1)];
+      tw->detect_delay_s = *tw->detect_time_s - tb_.strong_motion_start_s;
+    }
+    device(rec, f, device_alarm, &tw->device);
+  }
+
+  void device(const HilRecord& rec, const Factors& f, bool alarm, HilTwinDevice* d) const {
+    const DeviceParams& dp = b_.scene.params.device;
+    const int n = stories();
+    if (dp.kind == DeviceKind::kTmd) {
+      const double eta = std::max(f.eta[static_cast<std::size_t>(n)], 1e-9);
+      d->kind = "tmd";
+      d->frequency_factor = std::sqrt(eta);
+      d->frequency_factor_sd = 0.5 * f.sd[static_cast<std::size_t>(n)] / std::sqrt(eta);
+      d->truth_frequency_factor = tb_.truth.tmd_frequency_factor;
+      d->detuned = alarm;
+      return;
+    }
+    if (dp.kind != DeviceKind::kVines) return;
+    d->kind = "vines";
+    // Impulses: |F| integrated, the node's estimate and the truth's; impacts:
+    // excursions of |F| beyond 6 robust sd of the estimate, 20 ms apart; the
+    // mass the device floor gained, over the sphere's: a stuck sphere moves
+    // with its floor.
+    const double h = b_.h;
+    std::vector<double> F;
+    for (long long k = 0; k < rec.samples; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      d->impulse_truth_ns += std::fabs(tb_.truth.device_force[i]) * h;
+      if (!rec.got[i]) continue;
+      F.push_back(rec.tel[i].contact_force);
+      d->impulse_estimated_ns += std::fabs(F.back()) * h;
+    }
+    const double thr = 6 * robust_sd(F);
+    const auto dead = static_cast<long long>(std::ceil(0.02 / h));
+    long long last = -dead - 1;
+    for (std::size_t i = 0; i < F.size(); ++i)
+      if (std::fabs(F[i]) > thr && static_cast<long long>(i) - last > dead) ++d->impacts_estimated, last = static_cast<long long>(i);
+      else if (std::fabs(F[i]) > thr) last = static_cast<long long>(i);
+    d->contacts_truth = tb_.truth.contacts;
+    const int floor = (dp.floor > 0 ? dp.floor : n) - 1;
+    const double md = b_.scene.params.frame.mass_kg[floor], mp = tb_.truth.particle_mass;
+    d->added_mass_ratio = mp > 0 ? (f.eta[static_cast<std::size_t>(n)] - 1.0) * md / mp : 0.0;
+    d->sphere = d->added_mass_ratio > 0.5 ? "stuck" : d->impacts_estimated == 0 ? "still" : "moving";
+  }
+
+  const Bench& b_;
+  const TwinBench& tb_;
+  const bool estimator_;
+};
+
+}  // namespace
+
+std::unique_ptr<BenchMode> make_twin_mode(const Bench& b) { return std::make_unique<TwinMode>(b); }
+
+}  // namespace vines::host

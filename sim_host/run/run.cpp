@@ -1,0 +1,302 @@
+#include "sim_host/run/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+
+#include "host/record.hpp"
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/io/csv.hpp"
+#include "sim_host/io/digest.hpp"
+#include "sim_host/io/output.hpp"
+#include "sim_host/run/drive.hpp"
+#include "sim_host/scene/names.hpp"
+
+namespace vines::host {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::vector<double> head(const FloorArray& a, int n) { return {a.begin(), a.begin() + n}; }
+
+// One engine run over the samples; snapshots every `every` steps.
+struct Trace {
+  RunTotals totals;
+  ModelInfo info;
+  std::vector<Snapshot> rows;
+  double wall_s = 0;
+};
+
+Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
+  std::unique_ptr<Engine> eng = build_engine(p, scene.scalar, scene.path);
+  Trace tr;
+  tr.info = eng->info();
+  const auto t0 = std::chrono::steady_clock::now();
+  hal::RecordSource src(ex.samples, ex.rate_hz);
+  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) { tr.rows.push_back(eng->snapshot()); });
+  tr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  tr.totals = eng->totals();
+  return tr;
+}
+
+}  // namespace
+
+json modal_json(const ModelInfo& in) {
+  const int n = in.stories;
+  json mass_fraction = json::array(), shapes = json::array();
+  for (int j = 0; j < n; ++j) {
+    mass_fraction.push_back(in.m_eff[j] / in.total_mass);
+    shapes.push_back(head(in.mode_shapes[j], n));
+  }
+  return {{"frequency_hz", head(in.frequency_hz, n)},
+          {"damping_ratio", head(in.zeta, n)},
+          {"effective_mass_kg", head(in.m_eff, n)},
+          {"effective_mass_fraction", mass_fraction},
+          {"participation_factor", head(in.gamma, n)},
+          {"mode_shapes", shapes},  // phi_j * gamma_j, bottom floor first (Table 1's normalisation)
+          {"total_mass_kg", in.total_mass}};
+}
+
+namespace {
+
+json response_json(const RunTotals& t, int n) {
+  return {{"peak_displacement_m", head(t.peak_x, n)},
+          {"peak_drift_m", head(t.peak_drift, n)},
+          {"peak_top_displacement_m", t.peak_top},
+          {"t_peak_top_s", t.t_peak_top},
+          {"elastic_energy_integral", t.elastic_energy},
+          {"strain_energy_positive_increments", t.strain_increments}};
+}
+
+// The device's design as the model built it.
+json device_json(DeviceKind kind, const ModelInfo& info) {
+  json dp = {{"floor", info.device_floor}};
+  if (kind == DeviceKind::kTmd) {
+    const TmdDesign& d = info.tmd;
+    dp.update({{"mass_kg", d.mass}, {"k_n_per_m", d.k}, {"c_ns_per_m", d.c}, {"mu", d.mu},
+               {"lambda", d.lambda}, {"xi", d.xi}, {"frequency_hz", d.omega / (2 * M_PI)}});
+  }
+  if (kind == DeviceKind::kVines) {
+    const VinesDesign& d = info.vines;
+    dp.update({{"mass_kg", d.mass}, {"R_m", d.radius}, {"b_m", d.box_length}, {"gap_m", d.gap},
+               {"beta", d.box_length / (2 * d.radius)}, {"hertz_C", d.c}, {"eps", d.eps},
+               {"tau_s", d.tau}, {"v_ref_mps", d.v_ref}, {"reduced_mass_kg", d.m_star}});
+  }
+  return dp;
+}
+
+void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
+  CsvWriter csv(file.string());
+  const int n = dev.info.stories;
+  const DeviceKind kind = scene.params.device.kind;
+  // Header: time, ground, per-floor quantities, E_e, the device's state, the bare frame's.
+  csv.raw("t_s").raw("ag_mps2");
+  for (const char* q : {"x", "v", "acc", "drift"})
+    for (int i = 1; i <= n; ++i)
+      csv.raw(q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2"));
+  csv.raw("Ee_Js");
+  if (kind == DeviceKind::kVines)
+    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n", "contact_mode"})
+      csv.raw(h);
+  if (kind == DeviceKind::kTmd) csv.raw("tmd_x_m").raw("tmd_v_mps");
+  if (bare) csv.raw("bare_x_top_m").raw("bare_Ee_Js");
+  csv.end_row();
+  // One row per snapshot: time to the microsecond, the rest to 9 digits.
+  constexpr const char* kValue = "%.9g";
+  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
+    const Snapshot& s = dev.rows[r];
+    csv.number(s.t, "%.6f").number(s.ag, kValue);
+    for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift})
+      for (int i = 0; i < n; ++i) csv.number((*a)[i], kValue);
+    csv.number(s.elastic_energy, kValue);
+    if (kind == DeviceKind::kVines) {
+      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) csv.number(v, kValue);
+      csv.integer(s.mode);
+    }
+    if (kind == DeviceKind::kTmd) csv.number(s.tmd_x, kValue).number(s.tmd_v, kValue);
+    if (bare) csv.number(bare->rows[r].x[n - 1], kValue).number(bare->rows[r].elastic_energy, kValue);
+    csv.end_row();
+  }
+  csv.close();
+}
+
+// The scene's pga_g, the resampling to the sensor rate and duration_s, on a
+// loaded record (its scale already applied).
+Excitation finish_excitation(const Scene& scene, Excitation ex) {
+  const std::string& path = ex.record.path;
+  if (scene.target_pga_mps2 > 0.0) {
+    const double pga = ex.record.pga_mps2();
+    if (!(pga > 0.0)) throw std::runtime_error(path + ": all samples are zero, cannot scale to pga_g");
+    for (double& a : ex.record.accel_mps2) a *= scene.target_pga_mps2 / pga;
+  }
+  ex.rate_hz = scene.params.loop.sensor_rate_hz;
+  ex.samples = hal::resample(ex.record, ex.rate_hz);
+  if (scene.duration_s > 0.0) {
+    const auto keep = static_cast<std::size_t>(std::llround(scene.duration_s * ex.rate_hz)) + 1;
+    if (keep < ex.samples.size()) ex.samples.resize(keep);
+  }
+  if (ex.samples.size() < 2)
+    throw std::runtime_error(path + ": record too short for one step at the sensor rate");
+  return ex;
+}
+
+}  // namespace
+
+Excitation load_excitation(const Scene& scene, const std::string& record_override,
+                           const RecordReading& reading) {
+  hal::RecordSpec spec = scene.record;
+  if (!record_override.empty()) {
+    // The file's own format (detected unless forced), units, column and dt;
+    // the scene's scale / pga_g and duration_s still apply.
+    spec.path = record_override;
+    spec.format = reading.format;
+    spec.units = reading.units;
+    spec.column = reading.column;
+    spec.dt_s = reading.dt_s;
+    const bool values_only = spec.format == hal::RecordFormat::kAccel ||
+                             (spec.format == hal::RecordFormat::kAuto &&
+                              hal::detect_record_format(spec.path) == hal::RecordFormat::kAccel);
+    if (values_only && !(spec.dt_s > 0.0))
+      throw hal::RecordError("--record " + spec.path +
+                             ": one column of values and no time: give its sample step with --record-dt "
+                             "SECONDS (or --record-format for another format)");
+  } else {
+    spec.path = resolve_record_path(spec.path, scene.path);
+  }
+  Excitation ex;
+  ex.record = hal::load_record(spec);
+  return finish_excitation(scene, std::move(ex));
+}
+
+Excitation excitation_from_record(const Scene& scene, hal::Record record) {
+  hal::check_record(record);
+  for (double& a : record.accel_mps2) a *= scene.record.scale;
+  Excitation ex;
+  ex.record = std::move(record);
+  return finish_excitation(scene, std::move(ex));
+}
+
+RunReport run_scene(const Scene& scene, const RunOptions& opt) {
+  return run_scene(scene, load_excitation(scene, opt.record_override, opt.record_reading), opt);
+}
+
+RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& opt) {
+  const SceneParams& p = scene.params;
+  const bool has_device = p.device.kind != DeviceKind::kNone;
+  const bool series = !opt.out_dir.empty() && scene.output.timeseries;
+  const int every = series || opt.keep_series
+                        ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz))
+                        : 0;
+
+  // The run's folder, claimed (and locked) before the run: its marker keeps
+  // what the results come from, the scene's and the record's bytes.
+  std::optional<OutputDir> out;
+  if (!opt.out_dir.empty()) {
+    Digest d;
+    d.add(scene.path);
+    d.add_file(scene.path);
+    d.add_file(ex.record.path);
+    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv"}, d.hex());
+  }
+
+  // The device run, and with a device the bare frame on the same samples.
+  const Trace dev = run_engine(scene, p, ex, every);
+  Trace bare;
+  if (has_device) {
+    SceneParams pb = p;
+    pb.device.kind = DeviceKind::kNone;
+    bare = run_engine(scene, pb, ex, every);
+  }
+  RunReport r;
+  r.scene = scene.name;
+  r.scene_file = scene.path;
+  r.params = p;
+  r.scalar = scene.scalar;
+  r.record = {ex.record.path, ex.record.dt_s, ex.record.accel_mps2.size(), ex.record.pga_mps2(),
+              static_cast<double>(ex.samples.size() - 1) / ex.rate_hz};
+  r.info = dev.info;
+  r.totals = dev.totals;
+  if (has_device) r.bare = bare.totals;
+  r.wall_s = dev.wall_s;
+  r.status = device_status(r.totals, r.bare ? &*r.bare : nullptr, p, r.info, r.scalar);
+
+  // The run's folder: timeseries.csv, then summary.json (the file that says the
+  // run is complete) last; a timeseries.csv of an earlier run is removed.
+  if (out) {
+    std::vector<std::string> written{"summary.json"};
+    if (series) {
+      write_timeseries(out->file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
+      written.push_back("timeseries.csv");
+    }
+    write_file_atomic(out->file("summary.json"), r.to_json().dump(2) + '\n');
+    out->finish(written);
+  }
+  if (opt.keep_series) {
+    r.series = dev.rows;
+    if (has_device) r.bare_series = bare.rows;
+  }
+  return r;
+}
+
+json RunReport::to_json() const {
+  const SceneParams& p = params;
+  const RunTotals& t = totals;
+  json j;
+  j["scene"] = scene;
+  j["scene_file"] = scene_file;
+  j["device"] = device_name(p.device.kind);
+  if (p.device.kind == DeviceKind::kVines) j["contact_law"] = law_name(p.device.vines.law);
+  j["stories"] = info.stories;
+  j["scalar"] = scalar_name(scalar);
+  j["sensor_rate_hz"] = p.loop.sensor_rate_hz;
+  j["record"] = {{"path", record.path},
+                 {"dt_s", record.dt_s},
+                 {"points", record.points},
+                 {"pga_mps2", record.pga_mps2},
+                 {"simulated_s", record.simulated_s}};
+  j.update(response_json(t, info.stories));
+  if (bare) {
+    const RunTotals& b = *bare;
+    j["x_r"] = x_r();
+    j["E_r"] = E_r();
+    j["E_r_positive_increments"] = reduction(b.strain_increments, t.strain_increments);
+    j["bare"] = response_json(b, info.stories);
+  }
+  j["contacts"] = t.count.contacts;
+  if (p.device.kind == DeviceKind::kVines) j["max_overlap_m"] = t.max_overlap;
+  if (p.loop.energy_ledger) {
+    const Ledger& l = t.ledger;
+    j["energy_balance_residual"] = l.relative_residual();
+    j["energy_J"] = {{"input", l.input},     {"frame_damping", l.damping}, {"contact_dissipation", l.contact},
+                     {"kinetic", l.kinetic}, {"frame_strain", l.strain},   {"device_stored", l.device},
+                     {"residual", l.residual}};
+  } else {
+    j["energy_balance_residual"] = nullptr;
+    j["energy_balance"] = "not computed (loop.energy_ledger = false)";
+  }
+  j["counters"] = {{"steps", t.count.steps},
+                   {"substep_steps", t.count.careful_steps},
+                   {"substeps", t.count.substeps},
+                   {"contact_substeps", t.count.contact_substeps},
+                   {"rejected_substeps", t.count.rejected},
+                   {"events", t.count.events},
+                   {"substep_cap_hits", t.count.cap_hits},
+                   {"max_substeps_in_a_step", t.count.max_substeps_in_step},
+                   {"max_events_in_a_step", t.count.max_events_in_step},
+                   {"bad_samples_held", t.count.bad_samples},
+                   {"divergences_rolled_back", t.count.divergences}};
+  j["modal"] = modal_json(info);
+  if (bare) j["device_params"] = device_json(p.device.kind, info);
+  j["wall_time_s"] = wall_s;
+  // Whether the figures above can be trusted (docs/model.md, "Run status").
+  j["status"] = status.name();
+  j["degraded_reasons"] = status.reasons_json();
+  return j;
+}
+
+}  // namespace vines::host

@@ -1,0 +1,61 @@
+// Scene files: TOML descriptions of a run (frame, device, contact law, record,
+// loop settings, outputs), turned into SceneParams for the firmware core and a
+// RecordSpec for the host HAL. Every problem is a SceneError whose message
+// names the file and the key ("scene.toml: vines.beta: must be > 1 ...").
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "host/record.hpp"
+#include "sim_host/scene/scalar.hpp"
+#include "vines/params.hpp"
+
+namespace vines::host {
+
+struct OutputSpec {
+  double rate_hz = 100.0;  // timeseries rows per second of record (<= sensor rate)
+  bool timeseries = true;
+};
+
+struct Scene {
+  std::string path;       // the scene file
+  std::string name;       // [scene] name, default: file stem
+  SceneParams params;
+  hal::RecordSpec record;  // path resolved by resolve_record_path()
+  double duration_s = 0.0; // 0: the whole record
+  // 0: the record as loaded (times record.scale); > 0: the loader rescales
+  // the record so that its PGA is this value ([record] pga_g).
+  double target_pga_mps2 = 0.0;
+  Scalar scalar = Scalar::kDouble;
+  OutputSpec output;
+};
+
+// Scene files and study specs are at most 1 MiB: the largest shipped is 3 kB,
+// and a custom frame of 40 stories with every key written fits in 10 kB.
+inline constexpr std::uintmax_t kMaxSceneBytes = 1u << 20;
+
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Parses and validates a scene file (not a regular file, over kMaxSceneBytes,
+// unknown keys, wrong types, bad values are SceneErrors). The record path is left as written; see resolve_record_path.
+Scene load_scene(const std::string& path);
+
+// Whether "table.key" is a key of the scene format (a sweep's keys are
+// checked at load: a typo fails the spec, not every run).
+bool is_scene_key(const std::string& dotted);
+
+// Same, from TOML text (for tests); `origin` names it in messages.
+Scene parse_scene(const std::string& toml_text, const std::string& origin);
+
+// Finds a record file: an absolute path as is; a relative one is tried against
+// the working directory, the scene file's folder, then the ground-motion folder
+// ($VINES_GROUND_MOTIONS, else ../shared/data/ground_motions beside the
+// repository). Throws SceneError listing the places tried.
+std::string resolve_record_path(const std::string& record_path, const std::string& scene_path);
+
+}  // namespace vines::host
