@@ -1,4 +1,4 @@
-"""`pip install .`: the Python package vines (README, "Python").
+"""`pip install .`: the Python package vines (docs/python.md).
 
 The extension vines._vines is built by the project's CMake build (target
 _vines, sim_host/python), in build/pip unless VINES_BUILD_DIR names a

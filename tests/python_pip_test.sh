@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# README's `pip install .` lines (section "Python"), run as written but for
+# docs/python.md's `pip install .` lines, run as written but for
 # the venv's folder (a scratch one) and the build tree (the configured one
 # reused through VINES_BUILD_DIR, so the extension is not compiled twice);
 # the installed package, imported from outside the checkout, gives the same
@@ -11,9 +11,8 @@ build_dir=$(cd "$2" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-mapfile -t lines < <(sed -n '/^## Python/,/^## Studies/p' "$source_dir/README.md" |
-  grep -E '^(/usr/bin/python3 -m venv|~/venvs/vines/bin/pip) ')
-((${#lines[@]} == 2)) || { echo "FAIL: README's Python section has not its two pip lines" >&2; exit 1; }
+mapfile -t lines < <(grep -E '^(/usr/bin/python3 -m venv|~/venvs/vines/bin/pip) ' "$source_dir/docs/python.md")
+((${#lines[@]} == 2)) || { echo "FAIL: docs/python.md has not its two pip lines" >&2; exit 1; }
 for line in "${lines[@]}"; do
   echo "run: $line"
   (cd "$source_dir" && VINES_BUILD_DIR=$build_dir PIP_NO_INDEX=1 PIP_DISABLE_PIP_VERSION_CHECK=1 \

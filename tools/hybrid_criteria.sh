@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The shake-table (hybrid) mode's vRTHS criteria (docs/rths_criteria.md) over
-# compensators x actuators x records: README's table "Hybrid criteria".
+# compensators x actuators x records: the last table of docs/hil.md, "Hybrid
+# mode: statistics and the vRTHS criteria".
 #
 #   tools/hybrid_criteria.sh [VINES]     (VINES: the release build's vines)
 #

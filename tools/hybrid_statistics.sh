@@ -2,7 +2,8 @@
 # The shake-table (hybrid) mode judged as a chaotic specimen should be: by the
 # paper's reductions x_r and E_r (against the bare frame) over a grid of the
 # particle's initial conditions, hybrid against the pure simulation, rather
-# than by one trajectory. README, "Hardware in the loop".
+# than by one trajectory. docs/hil.md, "Hybrid mode: statistics and the vRTHS
+# criteria".
 #
 #   tools/hybrid_statistics.sh [VINES]     (VINES: the release build's vines)
 #

@@ -24,8 +24,9 @@ plots_pid=$!
 trap 'wait "$plots_pid" 2>/dev/null || true' EXIT
 
 # Only the 10-story frame (every device, double and float: every scene in
-# data/ and every README command), not the 1-story frame of the tests nor the
-# extra frames of `vines stress`: half the build's time and more.
+# data/ and every command of README.md and docs/), not the 1-story frame of
+# the tests nor the extra frames of `vines stress`: half the build's time and
+# more.
 # `cmake --preset release` (tools/test.sh) brings them back.
 cmake --preset release -DVINES_STORY_COUNTS=10 -DVINES_STRESS_STORY_COUNTS= >/dev/null
 cmake --build --preset release -j2 --target vines

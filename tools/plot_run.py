@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plot `vines run` outputs like the paper's Figures 6-9.
 
-Usage: plot_run.py RUN_DIR [RUN_DIR ...] [--out DIR]
+Usage: plot_run.py RUN_DIR [RUN_DIR ...] [--out DIR] [--dpi DPI]
 
 Each RUN_DIR holds summary.json and timeseries.csv (a bare, TMD or VI NES run).
 Writes into --out (default: out/plots; not a run folder, which vines run owns):
@@ -227,10 +227,15 @@ def fig9(bare, devs, out, written):
 
 
 def main(argv=None):
+    global DPI
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("run_dirs", nargs="+", metavar="RUN_DIR")
     ap.add_argument("--out", help="output directory (default: out/plots)")
+    ap.add_argument("--dpi", type=float, default=DPI, help=f"resolution of the PNGs (default: {DPI})")
     args = ap.parse_args(argv)
+    if not args.dpi > 0:
+        ap.error(f"--dpi must be positive, not {args.dpi}")
+    DPI = args.dpi
     runs = [Run(p) for p in args.run_dirs]
     out = args.out or "out/plots"
     try:

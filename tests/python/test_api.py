@@ -178,26 +178,24 @@ def test_bad_inputs_raise_with_their_name(tmp_path):
         vines.Record.load(tmp_path / "nothing.at2")
 
 
-def test_the_readme_python_section_runs_as_written(capfd):
-    with open(os.path.join(SOURCE, "README.md")) as f:
-        text = f.read()
-    section = text[text.index("## Python"):]
-    section = section[:section.index("\n## ", 1)]
-    blocks = section.split("```python\n")[1:]
-    assert blocks, "no python block in the README's Python section"
+def test_the_python_guide_runs_as_written(capfd):
+    with open(os.path.join(SOURCE, "docs", "python.md")) as f:
+        guide = f.read()
+    blocks = guide.split("```python\n")[1:]
+    assert blocks, "no python block in docs/python.md"
     cwd = os.getcwd()
     os.chdir(SOURCE)
     try:
         for block in blocks:
-            exec(compile(block[:block.index("```")], "README.md", "exec"), {})
+            exec(compile(block[:block.index("```")], "docs/python.md", "exec"), {})
     finally:
         os.chdir(cwd)
     out = capfd.readouterr().out
     assert "ok" in out and "(5377,)" in out  # status; t at 100 rows a second of 53.76 s
     assert "['ok' 'ok' 'ok']" in out  # the sweep's three runs
     assert "\n1.0 " in out  # the loop's last step, at t = 1 s
-    # The shell line of the section, as written (the package on PYTHONPATH as CTest sets it).
-    line = next(l for l in section.splitlines() if l.startswith("PYTHONPATH="))
+    # The shell line of the guide, as written (the package on PYTHONPATH as CTest sets it).
+    line = next(l for l in guide.splitlines() if l.startswith("PYTHONPATH="))
     cmd = line.split(" ", 1)[1]
     res = subprocess.run(["bash", "-c", cmd], cwd=SOURCE, capture_output=True, text=True, check=True)
     assert res.stdout.startswith("vines.Result(scene 'elcentro_vines', status ok")
