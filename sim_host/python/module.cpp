@@ -8,11 +8,7 @@
 
 #include <toml++/toml.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstddef>
-#include <future>
-#include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -20,73 +16,22 @@
 
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
+#include "sim_host/python/module.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/names.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "sim_host/scene/table.hpp"
-#include "sim_host/studies/sweep.hpp"
 
 namespace py = pybind11;
 using namespace vines;
 using namespace vines::host;
+using namespace vines::python;
 
 namespace {
-
-// A scene: its TOML table (what with_() edits and to_toml() writes) and the
-// checked Scene made from it. origin names it in messages and is the path
-// relative record paths are resolved against.
-struct PyScene {
-  toml::table table;
-  std::string origin;
-  Scene scene;
-};
 
 PyScene make_scene(toml::table table, const std::string& origin) {
   Scene s = scene_from_table(table, origin);
   return {std::move(table), origin, std::move(s)};
-}
-
-// Python values as TOML nodes: bool, int, float, str, list (or tuple), dict
-// (nested). `where` names the value in messages: "origin: section.key".
-toml::table to_table(const py::dict& d, const std::string& origin, const std::string& prefix);
-
-[[noreturn]] void bad_type(const std::string& where, const py::handle v) {
-  throw SceneError(where + ": a value of type " + std::string(py::str(v.get_type().attr("__name__"))) +
-                   " (bool, int, float, str, list or dict)");
-}
-
-toml::array to_array(const py::handle l, const std::string& origin, const std::string& key) {
-  toml::array out;
-  for (const py::handle item : l) {
-    if (py::isinstance<py::bool_>(item)) out.push_back(item.cast<bool>());
-    else if (py::isinstance<py::int_>(item)) out.push_back(item.cast<std::int64_t>());
-    else if (py::isinstance<py::float_>(item)) out.push_back(item.cast<double>());
-    else if (py::isinstance<py::str>(item)) out.push_back(item.cast<std::string>());
-    else if (py::isinstance<py::list>(item) || py::isinstance<py::tuple>(item)) out.push_back(to_array(item, origin, key));
-    else if (py::isinstance<py::dict>(item)) out.push_back(to_table(item.cast<py::dict>(), origin, key));
-    else bad_type(origin + ": " + key, item);
-  }
-  return out;
-}
-
-void insert(toml::table& t, const std::string& name, const py::handle v, const std::string& origin,
-            const std::string& key) {
-  if (py::isinstance<py::bool_>(v)) t.insert_or_assign(name, v.cast<bool>());
-  else if (py::isinstance<py::int_>(v)) t.insert_or_assign(name, v.cast<std::int64_t>());
-  else if (py::isinstance<py::float_>(v)) t.insert_or_assign(name, v.cast<double>());
-  else if (py::isinstance<py::str>(v)) t.insert_or_assign(name, v.cast<std::string>());
-  else if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) t.insert_or_assign(name, to_array(v, origin, key));
-  else if (py::isinstance<py::dict>(v)) t.insert_or_assign(name, to_table(v.cast<py::dict>(), origin, key));
-  else bad_type(origin + ": " + key, v);
-}
-
-toml::table to_table(const py::dict& d, const std::string& origin, const std::string& prefix) {
-  toml::table out;
-  for (const auto& [k, v] : d) {
-    const std::string name = py::str(k);
-    insert(out, name, v, origin, prefix.empty() ? name : prefix + "." + name);
-  }
-  return out;
 }
 
 // Sets "section.key" (dotted, as in study specs) in a copy of the table.
@@ -280,101 +225,6 @@ py::dict totals_dict(const RunTotals& t, int stories) {
   d["bad_samples_held"] = t.count.bad_samples;
   d["divergences_rolled_back"] = t.count.divergences;
   return d;
-}
-
-// A study of the scene as `vines sweep` runs one: grid (a key's list of
-// values, or {from, to, step | count, scale}, as in [study.grid]), set (fixed
-// keys), cases (a list of dicts of paired keys), on `threads` threads (0: all
-// cores) with the GIL released. Returns each run's keys and results, in the
-// order of the spec's plan (results.csv's rows).
-py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, const py::list& cases,
-               const std::string& group_by, int threads) {
-  const std::string origin = s.origin + " (sweep)";
-  toml::table study;
-  study.insert("name", "python");
-  study.insert("scene", "scene.toml");  // the study's scene is s, set below
-  if (!group_by.empty()) study.insert("group_by", group_by);
-  if (!grid.empty()) study.insert("grid", to_table(grid, origin, "grid"));
-  if (!set.empty()) study.insert("set", to_table(set, origin, "set"));
-  if (!cases.empty()) study.insert("cases", to_array(cases, origin, "cases"));
-  toml::array studies;
-  studies.push_back(std::move(study));
-  toml::table root;
-  root.insert("study", std::move(studies));
-  std::ostringstream text;
-  text << root;
-  SweepSpec spec = parse_sweep(text.str(), origin);
-  spec.studies[0].scene_path = s.origin;
-  std::ostringstream scene;
-  scene << s.table;
-  spec.studies[0].scene_toml = scene.str();
-  const std::vector<RunPlan> plan = plan_runs(spec);
-  // The runs on their own thread, the GIL released; Python's signals are
-  // checked every 0.1 s meanwhile: Ctrl-C stops the sweep (the runs under
-  // way are dropped within a second) and raises KeyboardInterrupt.
-  std::atomic<bool> stop{false};
-  auto job = std::async(std::launch::async, [&] { return execute(spec, plan, threads, 0, 1, &stop, false); });
-  for (;;) {
-    std::future_status st;
-    {
-      py::gil_scoped_release release;
-      st = job.wait_for(std::chrono::milliseconds(100));
-    }
-    if (st == std::future_status::ready) break;
-    if (PyErr_CheckSignals() != 0) {
-      stop = true;
-      {
-        py::gil_scoped_release release;
-        job.wait();
-      }
-      throw py::error_already_set();
-    }
-  }
-  const std::vector<RunResult> results = job.get();
-  // Columns: the plan's keys (results.csv's names), then the results.
-  py::dict out;
-  py::list keys;
-  std::vector<py::list> values;
-  if (!plan.empty())
-    for (const KeyValue& v : plan[0].values) {
-      keys.append(v.column());
-      values.emplace_back();
-    }
-  const auto n = static_cast<py::ssize_t>(results.size());
-  py::array_t<double> x_r(n), e_r(n), peak(n), ee(n);
-  py::array_t<long long> contacts(n);
-  py::list status, reasons, errors;
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    const RunResult& r = results[i];
-    for (std::size_t k = 0; k < values.size() && k < plan[i].values.size(); ++k) {
-      const KeyValue& v = plan[i].values[k];
-      if (v.text.empty() || v.scaled()) values[k].append(v.number);
-      else values[k].append(v.label());
-    }
-    // A failed run has no results: NaN (and -1 contacts).
-    const auto j = static_cast<py::ssize_t>(i);
-    const bool ok = r.done && r.error.empty();
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    x_r.mutable_at(j) = ok ? r.x_r : nan;
-    e_r.mutable_at(j) = ok ? r.E_r : nan;
-    peak.mutable_at(j) = ok ? r.peak_top : nan;
-    ee.mutable_at(j) = ok ? r.elastic_energy : nan;
-    contacts.mutable_at(j) = ok ? r.contacts : -1;
-    status.append(!r.error.empty() ? "failed" : r.degraded ? "degraded" : "ok");
-    reasons.append(r.degraded_reasons);
-    errors.append(r.error);
-  }
-  out["keys"] = keys;
-  out["values"] = py::cast(values);
-  out["x_r"] = x_r;
-  out["E_r"] = e_r;
-  out["peak_top_displacement_m"] = peak;
-  out["elastic_energy_integral"] = ee;
-  out["contacts"] = contacts;
-  out["status"] = status;
-  out["degraded_reasons"] = reasons;
-  out["error"] = errors;
-  return out;
 }
 
 // The modal report of the scene's frame (with its device's floor), as JSON text.
