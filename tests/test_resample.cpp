@@ -140,6 +140,26 @@ TEST(RecordSourceTest, HandsOutSamplesAndAdvancesClockExactly) {
   EXPECT_EQ(clock.now_ns(), 1'000'000'000'000ull);
 }
 
+TEST(RecordSourceTest, ReadInBlocksIsNextSampleBySample) {
+  const std::size_t n = 1000;
+  std::vector<double> samples(n);
+  for (std::size_t i = 0; i < n; ++i) samples[i] = 0.5 * static_cast<double>(i);
+  for (const std::size_t block : {std::size_t{1}, std::size_t{7}, std::size_t{999}, std::size_t{4096}}) {
+    SimClock clock;
+    RecordSource src(samples, 3.0, &clock);
+    std::vector<double> got, buf(block);
+    while (const std::size_t k = src.read(buf.data(), block)) {
+      got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(k));
+      // The clock reads the time of the last sample handed out, as after next().
+      ASSERT_EQ(clock.now_ns(), static_cast<std::uint64_t>(std::llround((got.size() - 1) * 1e9 / 3.0))) << block;
+    }
+    EXPECT_EQ(got, samples) << block;
+    EXPECT_EQ(src.position(), n);
+    double a = 0;
+    EXPECT_FALSE(src.next(&a));
+  }
+}
+
 TEST(RecordSourceTest, WorksWithoutClockAndRejectsBadRate) {
   const std::vector<double> samples = {1.0, 2.0};
   RecordSource src(samples, 1000.0);

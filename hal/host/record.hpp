@@ -110,10 +110,12 @@ class RecordSource final : public GroundSource {
   RecordSource(std::vector<double>&&, double, SimClock* = nullptr) = delete;  // would dangle
   double rate_hz() const override { return rate_hz_; }
   bool next(double* accel_mps2) override;
+  std::size_t read(double* out, std::size_t n) override;
   std::size_t size() const { return n_; }
   std::size_t position() const { return pos_; }
 
  private:
+  void advance_clock(std::size_t from, std::size_t to);  // from sample `from`'s time to `to`'s
   const double* samples_;
   std::size_t n_;
   double rate_hz_;

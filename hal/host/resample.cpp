@@ -65,17 +65,28 @@ RecordSource::RecordSource(const double* samples_mps2, std::size_t n, double rat
   }
 }
 
+void RecordSource::advance_clock(std::size_t from, std::size_t to) {
+  // By the difference of exact tick times, so rounding never accumulates.
+  auto tick = [this](std::size_t k) {
+    return static_cast<std::uint64_t>(std::llround(static_cast<double>(k) * 1e9 / rate_hz_));
+  };
+  if (clock_ != nullptr && to > from) clock_->advance_ns(tick(to) - tick(from));
+}
+
 bool RecordSource::next(double* accel_mps2) {
   if (pos_ >= n_) return false;
-  if (clock_ != nullptr && pos_ > 0) {
-    // Advance by the difference of exact tick times so rounding never accumulates.
-    auto tick = [this](std::size_t k) {
-      return static_cast<std::uint64_t>(std::llround(static_cast<double>(k) * 1e9 / rate_hz_));
-    };
-    clock_->advance_ns(tick(pos_) - tick(pos_ - 1));
-  }
+  if (pos_ > 0) advance_clock(pos_ - 1, pos_);
   *accel_mps2 = samples_[pos_++];
   return true;
+}
+
+std::size_t RecordSource::read(double* out, std::size_t n) {
+  const std::size_t k = std::min(n, n_ - pos_);
+  if (k == 0) return 0;
+  std::copy(samples_ + pos_, samples_ + pos_ + k, out);
+  advance_clock(pos_ == 0 ? 0 : pos_ - 1, pos_ + k - 1);  // the clock reads the last sample's time
+  pos_ += k;
+  return k;
 }
 
 }  // namespace vines::hal

@@ -6,6 +6,7 @@
 // (the heap) into the MCU image. Owners destroy concrete types.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace vines::hal {
@@ -18,6 +19,13 @@ class GroundSource {
   // Writes the next sample and returns true, or returns false at the end of
   // the stream (or on a fault the backend reports through its own status).
   virtual bool next(double* accel_mps2) = 0;
+  // Up to n next samples into out[0..); returns how many (fewer only at the
+  // end of the stream). A backend with its samples in memory copies them.
+  virtual std::size_t read(double* out, std::size_t n) {
+    std::size_t k = 0;
+    while (k < n && next(out + k)) ++k;
+    return k;
+  }
 
  protected:
   ~GroundSource() = default;
