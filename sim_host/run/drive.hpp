@@ -14,7 +14,7 @@
 namespace vines::host {
 
 // Samples handed to the target per call between two stop checks (4 s of a
-// 1 kHz record: a Ctrl-C is seen within a fraction of a millisecond).
+// 1 kHz record, milliseconds of work: a Ctrl-C is seen at once).
 inline constexpr std::size_t kDriveBlock = 4096;
 
 // Feeds every sample of `src` to `target`: the first to init(a), the others

@@ -7,18 +7,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <future>
-#include <iterator>
 #include <map>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
 
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
-#include "sim_host/io/csv.hpp"
-#include "sim_host/io/output.hpp"
 #include "sim_host/run/drive.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/run/status.hpp"
@@ -30,9 +25,6 @@
 
 namespace vines::host {
 namespace {
-
-namespace fs = std::filesystem;
-using nlohmann::json;
 
 // Keys that only say where the device starts: runs that differ in nothing
 // else share a built model.
