@@ -22,16 +22,13 @@ AG = np.convolve(rng.standard_normal(5000), np.ones(25) / 5, mode="same")  # 10 
 
 
 def recursion(k, m, ag):
-    """The same outputs, integrated step by step with the exact (ZOH) transition."""
-    n = len(m)
-    Kf = np.diag(k + np.append(k[1:], 0.0)) - np.diag(k[1:], 1) - np.diag(k[1:], -1)
-    Minv = np.diag(1.0 / m)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ Kf, -tb.DAMPING_S * Minv @ Kf]])
+    """The same outputs, integrated step by step with the exact (ZOH) transition (the
+    check is of the FFT simulation: the state space is tools/twin_bound.py's)."""
+    A, b, C = tb.state_space(k, m, SENSORS)
     lam, V = np.linalg.eig(A)
     Ad = (V @ np.diag(np.exp(lam * H)) @ np.linalg.inv(V)).real
-    Bd = (V @ np.diag((np.exp(lam * H) - 1) / lam) @ np.linalg.inv(V)).real @ np.concatenate([np.zeros(n), -np.ones(n)])
-    C = (-Minv @ np.hstack([Kf, tb.DAMPING_S * Kf]))[np.asarray(SENSORS) - 1]
-    x, out = np.zeros(2 * n), []
+    Bd = (V @ np.diag((np.exp(lam * H) - 1) / lam) @ np.linalg.inv(V)).real @ b
+    x, out = np.zeros(len(b)), []
     for a in ag:
         out.append(C @ x)
         x = Ad @ x + Bd * a
