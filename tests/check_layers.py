@@ -72,9 +72,7 @@ def check_rooms(root):
     for dirpath, _, names in os.walk(top):
         rel = os.path.relpath(dirpath, top).replace(os.sep, "/")
         sources = [n for n in sorted(names) if n.endswith(SOURCE)]
-        room = rel.split("/")[0] if rel.split("/")[0] not in ("hil",) else rel
-        if room == "python" or rel.startswith("python/"):
-            room = "python"
+        room = rel if rel.split("/")[0] == "hil" else rel.split("/")[0]  # hil's folders are rooms each
         if sources and room not in HOST_ROOMS:
             problems += [f"sim_host/{rel}/{n}: not in a room of sim_host/README.md" for n in sources]
             continue

@@ -133,9 +133,7 @@ void add_hil(CLI::App& vines) {
            if (std::find(names.begin(), names.end(), v) != names.end()) {
              opt.node = v;
            } else if (v.rfind("qemu:", 0) == 0) {
-             std::string known;
-             for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-             throw CLI::ValidationError("--node", v + ": not a node (" + known + ", or a program's path)");
+             throw CLI::ValidationError("--node", v + ": not a node (" + host::node_list() + ", or a program's path)");
            } else {
              opt.node_command = v;
            }
