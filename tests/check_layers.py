@@ -24,6 +24,11 @@ files and the rooms below it; no source file outside a room, no room of more
 than 20 source files:
   io < scene < engines < run < reference < studies, hil (hil/, hil/link/,
   hil/modes/: one bench) < python < cli
+
+No contact law is named outside its registry (firmware/include/vines/
+contact_laws.hpp; params.hpp holds the codes): the product's code (firmware/,
+hal/, sim_host/) reaches a law through the table, never as ContactLaw::kName
+or laws::Name (tests may).
 """
 import os
 import re
@@ -92,6 +97,28 @@ def check_rooms(root):
     return problems
 
 
+LAW_NAMED = re.compile(r"ContactLaw::k[A-Z]|laws::[A-Z][a-z]")
+LAW_REGISTRY = ("firmware/include/vines/contact_laws.hpp", "firmware/include/vines/params.hpp")
+
+
+def check_laws(root):
+    """No law named outside the registry, in the product's code."""
+    problems = []
+    for folder in ("firmware", "hal", "sim_host"):
+        for dirpath, _, names in os.walk(os.path.join(root, folder)):
+            for name in sorted(names):
+                path = os.path.join(dirpath, name)
+                rel = os.path.relpath(path, root).replace(os.sep, "/")
+                if not name.endswith(SOURCE) or rel in LAW_REGISTRY:
+                    continue
+                with open(path, encoding="utf-8", errors="replace") as f:
+                    for n, line in enumerate(f, 1):
+                        if LAW_NAMED.search(line.split("//")[0]):
+                            problems.append(f"{rel}:{n}: names a contact law: reach it through the registry "
+                                            f"(contact_laws.hpp: with_law, law_name, LawOf, law_keep)")
+    return problems
+
+
 def check_file(root, layer, folder, roots, angle_ok, path):
     problems = []
     here = os.path.dirname(path)
@@ -133,6 +160,7 @@ def main(argv):
                     files += 1
                     problems += check_file(root, layer, folder, roots, angle_ok, os.path.join(dirpath, name))
     problems += check_rooms(root)
+    problems += check_laws(root)
     for p in problems:
         print(p)
     print(f"check_layers: {files} files, {len(problems)} problems")

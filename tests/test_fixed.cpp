@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "support.hpp"
-#include "vines/model.hpp"
+#include "vines/build_model.hpp"
 #include "vines/numeric/fixed_modal.hpp"
 
 namespace vines {

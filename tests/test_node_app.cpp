@@ -15,6 +15,7 @@
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/modes/plant.hpp"
 #include "support.hpp"
+#include "vines/build_model.hpp"
 #include "vines/link/model_plant.hpp"
 #include "vines/model_image.hpp"
 

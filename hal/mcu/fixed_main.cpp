@@ -10,7 +10,7 @@
 #include "semihost.h"
 #include "vines/frame_presets.hpp"
 #include "vines/hal/port.hpp"
-#include "vines/model.hpp"
+#include "vines/build_model.hpp"
 #include "vines/numeric/fixed_modal.hpp"
 
 namespace {

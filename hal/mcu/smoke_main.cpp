@@ -1,6 +1,6 @@
 // MCU smoke image: the real firmware loop on the target (the toolchain's
 // scalar: float on the Cortex-M4F, double on the Cortex-M7): builds the table-1 frame with the default VI NES
-// (Kuwabara, beta 1.35) and runs it at 1 kHz under a near-resonant sine,
+// (its default contact law, beta 1.35) and runs it at 1 kHz under a near-resonant sine,
 // fed sample by sample. Checks invariants that hold in any scalar: the first
 // frequency, contacts happen, the state stays finite, the energy balances.
 // Reports through semihosting; exit status 0 = pass. It must stay heap-free:
@@ -15,7 +15,7 @@
 namespace {
 
 using Scalar = VINES_MCU_SCALAR;  // from the toolchain file (cmake/arm-none-eabi.cmake)
-using Dev = vines::VinesDevice<vines::ContactLaw::kKuwabara>;
+using Dev = vines::VinesDevice<vines::VinesParams{}.law>;  // the scene's default law
 constexpr int kStories = 10;
 constexpr double kPi = 3.14159265358979323846;
 

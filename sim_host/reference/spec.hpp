@@ -12,7 +12,7 @@ namespace vines::host::reference {
 struct OdeSpec {
   HostFrame frame;
   DeviceKind kind = DeviceKind::kNone;
-  ContactLaw law = ContactLaw::kKuwabara;
+  ContactLaw law = VinesParams{}.law;  // the scene's default
   int floor = 0;  // device floor, 0-based
   TmdDesign tmd;
   VinesDesign vines;

@@ -31,9 +31,7 @@ std::optional<LimitError> check_contact_scales(const SceneParams& p) {
   // first mode (as build_model), the Hertz prefactor C of the pair.
   const double m_eff1 = host_modes(build_host_frame(undamaged(p.frame))).m_eff[0];
   const double mass = p.device.mass_kg > 0.0 ? p.device.mass_kg : p.device.mass_ratio * m_eff1;
-  VinesParams hertz = p.device.vines;
-  hertz.law = ContactLaw::kHertz;  // C, radius and mass only: no Kuwabara calibration
-  const VinesDesign d = design_vines(hertz, mass, 1.0);
+  const VinesDesign d = design_particle(p.device.vines, mass, 1.0);  // no law's calibration
   const VinesParams& v = p.device.vines;
   // The box's free travel, from beta (or the box's length) and the radius:
   // finite, and within what a building's device could be.
@@ -46,7 +44,7 @@ std::optional<LimitError> check_contact_scales(const SceneParams& p) {
                           ", radius " + num(d.radius) + " m), beyond the " + num(kMaxGapM) +
                           " m a building's device could have"};
   }
-  if (v.law == ContactLaw::kRestitution) return std::nullopt;
+  if (law_impulsive(v.law)) return std::nullopt;
   const double speed = std::max({v.v_ref_mps, std::fabs(v.initial_velocity_mps), kMinRepresentativeSpeed});
   const double t_c = contact::hertz_duration(d.mass, d.c, speed);
   const double overlap = contact::hertz_max_overlap(d.mass, d.c, speed);

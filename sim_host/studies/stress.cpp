@@ -127,11 +127,9 @@ std::unique_ptr<Engine> build(const SceneParams& p, Scalar scalar, std::string* 
 double energy_bound(const StressCase& c) {
   if (c.scalar == Scalar::kFloat) return 5e-3;
   if (c.params.device.kind == DeviceKind::kNone) return 1e-10;
-  switch (c.params.device.vines.law) {
-    case ContactLaw::kHertz: return 1e-5;
-    case ContactLaw::kRestitution: return 1e-8;
-    default: return 1e-7;
-  }
+  double bound = 0;
+  with_law(c.params.device.vines.law, [&](auto law) { bound = decltype(law)::kBalanceTol; });
+  return bound;
 }
 
 // Halved step, relative differences allowed: the state at the compare sample
@@ -254,9 +252,9 @@ StressResult run_case(const StressCase& c, const std::vector<StressRecord>& reco
   r.checks[kCap] = {vines, static_cast<double>(t.count.cap_hits), 0.0};
   if (vines) check_overlap(c, info, full, &r);
   r.degraded_reasons = run_status(t, c.params, info, c.scalar).codes();
-  // The other runs reuse the calibrated Kuwabara tau.
+  // The other runs keep the law's calibration (law_keep).
   SceneParams p = c.params;
-  if (vines && p.device.vines.law == ContactLaw::kKuwabara && info.vines.tau > 0) p.device.vines.tau_s = info.vines.tau;
+  if (vines) law_keep(info.vines, &p.device.vines);
   check_half_step(c, p, info, a, full, &r);
   if (c.small_cap > 0) check_small_cap(c, p, a, &r);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -31,8 +31,8 @@ namespace {
 constexpr std::string_view kInitialConditionKeys[] = {"vines.initial_position_m", "vines.initial_velocity_mps",
                                                       "tmd.initial_position_m", "tmd.initial_velocity_mps"};
 
-// Results shared between runs: excitations, bare frames, Kuwabara tau, VI
-// NES free travel; each keyed on every scene input it depends on.
+// Results shared between runs: excitations, bare frames, VI NES designs (a
+// law's calibration), VI NES free travel; each keyed on every scene input it depends on.
 class Cache {
  public:
   explicit Cache(const std::atomic<bool>* stop) : stop_(stop) {}
@@ -50,22 +50,21 @@ class Cache {
                                     "loop.contact_scheme", "loop.bounded_substeps", "loop.floor_peaks"});
     return get<RunTotals>(bares_, key, [&] { return run_totals(r.scene, p, *excitation(r), stop_); });
   }
-  // The tau a Kuwabara scene calibrates to (same for every initial condition).
-  double tau(const RunScene& r) {
+  // The VI NES design a scene builds (its law's calibration: the same for
+  // every initial condition).
+  VinesDesign design(const RunScene& r) {
     SceneParams p = r.scene.params;
     p.device.vines.initial_position_m = p.device.vines.initial_velocity_mps = 0;
     p.device.vines.start_at_left_wall = true;
     const std::string key = key_of(scalar_name(r.scene.scalar), r.table, {"frame", "device", "vines", "loop"},
                                    {"vines.initial_position_m", "vines.initial_velocity_mps"});
-    return *get<double>(taus_, key, [&] { return build(r.scene, p)->info().vines.tau; });
+    return *get<VinesDesign>(designs_, key, [&] { return build(r.scene, p)->info().vines; });
   }
-  // A run's parameters as built: a Kuwabara scene without tau gets the one it
-  // calibrates to.
+  // A run's parameters as built: a VI NES scene keeps its law's calibration
+  // (law_keep: Kuwabara's tau).
   SceneParams built_params(const RunScene& r) {
     SceneParams p = r.scene.params;
-    if (p.device.kind == DeviceKind::kVines && p.device.vines.law == ContactLaw::kKuwabara &&
-        p.device.vines.tau_s == 0.0)
-      p.device.vines.tau_s = tau(r);
+    if (p.device.kind == DeviceKind::kVines) law_keep(design(r), &p.device.vines);
     return p;
   }
   // VI NES free travel of a scene's design.
@@ -166,7 +165,8 @@ class Cache {
   std::mutex mutex_;
   Map<Excitation> excitations_;
   Map<RunTotals> bares_;
-  Map<double> taus_, gaps_;
+  Map<VinesDesign> designs_;
+  Map<double> gaps_;
   Map<Base> bases_;
 };
 

@@ -43,9 +43,17 @@ inline double tsuji_d(double eps) {
 }
 
 // Each law also gives its force in terms of q = d^{1/4} (regular(q, dd)):
-// a polynomial in q, what the loop integrates contacts in (substep.hpp).
+// a polynomial in q, what the loop integrates contacts in (substep.hpp), and
+// the energy its elastic part stores at overlap d (potential(d)).
 // coefficients(f) calls f with a pointer to each coefficient member, in
 // order: the model image carries them (model_image_fields.hpp).
+
+// Energy stored by the elastic part C d^{3/2} at overlap d: (2/5) C d^{5/2}.
+template <typename S>
+S hertz_potential(S c, S d) {
+  using std::sqrt;
+  return S(0.4) * c * d * d * sqrt(d);
+}
 
 // F = C d^{3/2}.
 template <typename S>
@@ -59,6 +67,7 @@ struct Hertz {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, S(0)};
   }
+  S potential(S d) const { return hertz_potential(c, d); }
   template <typename F>
   static constexpr void coefficients(F&& f) { f(&Hertz::c); }
 };
@@ -77,6 +86,7 @@ struct Tsuji {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, g * q * dd};
   }
+  S potential(S d) const { return hertz_potential(c, d); }
   template <typename F>
   static constexpr void coefficients(F&& f) {
     f(&Tsuji::c);
@@ -98,6 +108,7 @@ struct Kuwabara {
     const S q2 = q * q;
     return {c * q2 * q2 * q2, g * q2 * dd};
   }
+  S potential(S d) const { return hertz_potential(c, d); }
   template <typename F>
   static constexpr void coefficients(F&& f) {
     f(&Kuwabara::c);

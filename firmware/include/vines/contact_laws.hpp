@@ -9,6 +9,10 @@
 //   kernel<S>(d)  that kernel from a design
 //   check(p)    its own parameter checks (validate.hpp calls it)
 //   design(p, d)  its design step: its constants, once, in double
+//   keep(d, p)  makes the parameters p rebuild the design d without its
+//               calibration (the runs of a study share one: Kuwabara's tau)
+//   kBalanceTol the energy-balance residual (relative) a run of the law is
+//               held to (vines stress; measured, docs/speed.md)
 // ContactLaws, the table below, lists them, one line a law. Everything that
 // enumerates laws reads it: the scene choices and names (law_name,
 // each_law), validation, the model's kernel type (LawOf), the model image's
@@ -54,6 +58,8 @@ struct Hertz {
   static Kernel<S> kernel(const VinesDesign& d) { return {static_cast<S>(d.c)}; }
   static ParamError check(const VinesParams&) { return {}; }
   static void design(const VinesParams&, VinesDesign* d) { d->eps = 1.0; }
+  static void keep(const VinesDesign&, VinesParams*) {}
+  static constexpr double kBalanceTol = 1e-5;  // elastic: chatters most
 };
 
 // Tsuji: g = D(eps) sqrt(C m*), m* the particle/floor reduced mass.
@@ -70,6 +76,8 @@ struct Tsuji {
     d->eps = p.eps;
     d->g = contact::tsuji_d(d->eps) * std::sqrt(d->c * d->m_star);
   }
+  static void keep(const VinesDesign&, VinesParams*) {}
+  static constexpr double kBalanceTol = 1e-7;
 };
 
 // Kuwabara-Kono: g = 1.5 C tau, tau given or calibrated so that the particle
@@ -100,6 +108,10 @@ struct Kuwabara {
     d->ok = d->tau >= 0.0;
     d->g = 1.5 * d->c * d->tau;
   }
+  static void keep(const VinesDesign& d, VinesParams* p) {
+    if (p->tau_s == 0.0 && d.tau > 0.0) p->tau_s = d.tau;
+  }
+  static constexpr double kBalanceTol = 1e-7;
 };
 
 // Restitution: Newton's law with eps between the particle and the floor mass
@@ -114,6 +126,8 @@ struct Restitution {
   static Kernel<S> kernel(const VinesDesign& d) { return {static_cast<S>(d.c)}; }
   static ParamError check(const VinesParams& v) { return check_eps(v); }
   static void design(const VinesParams& p, VinesDesign* d) { d->eps = p.eps; }
+  static void keep(const VinesDesign&, VinesParams*) {}
+  static constexpr double kBalanceTol = 1e-8;
 };
 
 }  // namespace laws
@@ -190,6 +204,11 @@ constexpr const char* law_name(ContactLaw law) {
   const char* name = nullptr;
   with_law(law, [&](auto l) { name = decltype(l)::kName; });
   return name;
+}
+
+// The parameters p rebuild the design d without its law's calibration.
+inline void law_keep(const VinesDesign& d, VinesParams* p) {
+  with_law(p->law, [&](auto l) { decltype(l)::keep(d, p); });
 }
 
 // The law is an instantaneous impact (false for a code no law has).

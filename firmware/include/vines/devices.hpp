@@ -22,6 +22,8 @@ template <ContactLaw L>
 struct VinesDevice {
   static constexpr DeviceKind kKind = DeviceKind::kVines;
   static constexpr ContactLaw kLaw = L;
+  // Its law's impacts are instantaneous (contact_laws.hpp, kImpulsive).
+  static constexpr bool kImpulsive = LawOf<L>::kImpulsive;
 };
 
 // ---- TMD: Den Hartog (Eq. 18) on the nominal frame's first mode ----
@@ -51,7 +53,8 @@ inline TmdDesign design_tmd(const TmdParams& p, double mass, double m_eff1, doub
 }
 
 // ---- VI NES: sphere, box, then the law's design step (contact_laws.hpp) ----
-inline VinesDesign design_vines(const VinesParams& p, double mass, double floor_mass) {
+// The sphere, the box and the Hertz pair, before any law's step.
+inline VinesDesign design_particle(const VinesParams& p, double mass, double floor_mass) {
   constexpr double kPi = 3.14159265358979323846;
   VinesDesign d;
   if (p.radius_m > 0.0) {
@@ -66,6 +69,11 @@ inline VinesDesign design_vines(const VinesParams& p, double mass, double floor_
   d.c = contact::hertz_c(p.young_pa, p.poisson, p.wall_young_pa, p.wall_poisson, d.radius);
   d.m_star = d.mass * floor_mass / (d.mass + floor_mass);
   d.v_ref = p.v_ref_mps;
+  return d;
+}
+
+inline VinesDesign design_vines(const VinesParams& p, double mass, double floor_mass) {
+  VinesDesign d = design_particle(p, mass, floor_mass);
   with_law(p.law, [&](auto law) { decltype(law)::design(p, &d); });
   return d;
 }

@@ -34,7 +34,7 @@ int due_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y) {
       const S r = st.rel_pos(y), rd = st.rel_vel(y);
       // An impact needs an approach speed the law resolves (a particle just
       // released from a wall sits on it with a rounding-level speed).
-      const S v_min = Dev::kLaw == ContactLaw::kRestitution ? static_cast<S>(kStickSpeed) : S(0);
+      const S v_min = Dev::kImpulsive ? static_cast<S>(kStickSpeed) : S(0);
       if (overlap_left<S>(dm, r) > tol && rd < -v_min) return -1;
       if (overlap_right<S>(dm, r) > tol && rd > v_min) return 1;
       return 0;
@@ -92,14 +92,14 @@ VINES_INLINE S event_value(const Model<S, N, Dev>& m, const Stepper& st, const V
 }
 
 // Does an event happen inside the sub-step from (y0, f0) to (y1, f1), of
-// length hs? Which first? From the cubic Hermite interpolant of each event
+// length du? Which first? From the cubic Hermite interpolant of each event
 // function (linear for the holding force, whose slope is not known): true
 // and *theta (the fraction of the sub-step: the first up-crossing on the
 // cubic, bisected `halvings` times after a 16-point grid), *side; false if
 // none.
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& y0, const Vec& f0,
-                              const Vec& y1, const Vec& f1, S hs, S h, int halvings, S* theta, int* side) {
+                              const Vec& y1, const Vec& f1, S du, S h, int halvings, S* theta, int* side) {
   const bool reg = st.regular();
   bool any = false;
   for (int sd = -1; sd <= 1; ++sd) {
@@ -107,7 +107,7 @@ VINES_INLINE bool first_event(const Model<S, N, Dev>& m, const Stepper& st, cons
     if (st.mode != Mode::kFree && sd == 1) break;
     S s0, s1;
     const S g0 = event_value(m, st, y0, f0, sd, h, &s0), g1 = event_value(m, st, y1, f1, sd, h, &s1);
-    const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
+    const auto cub = numeric::Cubic<S>::make(g0, s0, g1, s1, du);
     const bool stuck = riding(st.mode);
     const bool hit = g1 > S(0) || (!stuck && g0 <= S(0) && cub.max_value() > S(0));
     if (!hit || g0 > S(0)) continue;
@@ -177,11 +177,11 @@ struct DenseEvent {
 };
 
 // The event function of `side` less its target (g0 at y, g1 at r.y) along
-// the dense output of the step r from (y, f) of length hs (not for a
+// the dense output of the step r from (y, f) of length du (not for a
 // particle riding a wall: its holding force is not affine in the state).
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 DenseEvent<S> dense_event(const Model<S, N, Dev>& m, const Stepper& st, const Vec& f,
-                          const numeric::Dopri5Result<Vec>& r, S hs, int side, S g0, S g1) {
+                          const numeric::Dopri5Result<Vec>& r, S du, int side, S g0, S g1) {
   numeric::Dopri5Result<S> p;
   p.y = g1;
   p.f = event_change(m, st, r.f, side);
@@ -189,18 +189,18 @@ DenseEvent<S> dense_event(const Model<S, N, Dev>& m, const Stepper& st, const Ve
   p.k4 = event_change(m, st, r.k4, side);
   p.k5 = event_change(m, st, r.k5, side);
   p.k6 = event_change(m, st, r.k6, side);
-  return {numeric::dopri5_dense(p, g0, event_change(m, st, f, side), hs)};
+  return {numeric::dopri5_dense(p, g0, event_change(m, st, f, side), du)};
 }
 
 // Places the event first_event found (side; theta its guess) on the true
-// sub-step r from (y, f) at u, of length hs. The acceptance band of the
+// sub-step r from (y, f) at u, of length du. The acceptance band of the
 // event function is [0, tol] (the end of the sensor step, side 0: t within
 // rounding of h), aimed at its middle:
 //   1. the root on the step's dense output (DenseEvent);
 //   2. one trial step to it;
 //   3. its end moved onto the root by a first-order step along f (length
 //      dtau = -g / g'), which errs by dtau^2 y'' / 2: taken only while
-//      |dtau| <= 0.1 sqrt(rtol) hs, where that is below 0.005 rtol of the
+//      |dtau| <= 0.1 sqrt(rtol) du, where that is below 0.005 rtol of the
 //      step's own curvature term; the dense output's error keeps dtau far
 //      smaller.
 // Where a step misses (no dense crossing, a riding particle, dtau too long,
@@ -209,24 +209,24 @@ DenseEvent<S> dense_event(const Model<S, N, Dev>& m, const Stepper& st, const Ve
 // 40. Returns the step to the event, *tau_out its length.
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 VINES_INLINE numeric::Dopri5Result<Vec> locate_event(const Model<S, N, Dev>& m, const Stepper& st, S u, const Vec& y,
-                                                     const Vec& f, const numeric::Dopri5Result<Vec>& r, S hs, S h,
+                                                     const Vec& f, const numeric::Dopri5Result<Vec>& r, S du, S h,
                                                      S theta, int side, S rtol, S* tau_out) {
   constexpr S kEps = std::numeric_limits<S>::epsilon();
   const S tol = side == 0 ? S(4) * kEps * h : m.dev.event_tol;
   auto in_band = [&](S g) { return std::fabs(g) <= tol && g >= S(0); };
-  S lo = S(0), hi = hs, slope;
+  S lo = S(0), hi = du, slope;
   S glo = event_value(m, st, y, f, side, h, &slope);
   S ghi = event_value(m, st, r.y, r.f, side, h, &slope);
   const S aim = S(0.5) * tol;
   S th;
-  if (!riding(st.mode) && dense_event(m, st, f, r, hs, side, glo - aim, ghi - aim).first_crossing(&th)) theta = th;
+  if (!riding(st.mode) && dense_event(m, st, f, r, du, side, glo - aim, ghi - aim).first_crossing(&th)) theta = th;
   if (!(ghi > S(0))) ghi = S(1);
-  S tau = theta * hs;
+  S tau = theta * du;
   auto rr = numeric::dopri5_step<Vec>(st, u, y, f, tau);
   S g = event_value(m, st, rr.y, rr.f, side, h, &slope);
   if (!in_band(g) && slope > S(0)) {
     const S dtau = -(g - aim) / slope;
-    if (std::fabs(dtau) <= S(0.1) * std::sqrt(rtol) * hs && tau + dtau > S(0) && tau + dtau < hs) {
+    if (std::fabs(dtau) <= S(0.1) * std::sqrt(rtol) * du && tau + dtau > S(0) && tau + dtau < du) {
       tau += dtau;
       rr.y += dtau * rr.f;
       rr.f = st(u + tau, rr.y);

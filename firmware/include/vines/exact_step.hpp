@@ -135,7 +135,7 @@ void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
 template <typename S, int N, typename Dev>
 VINES_INLINE bool clear_of_walls(const Model<S, N, Dev>& m, S r0, S rd0, S r1, S rd1) {
   const auto& dm = m.dev;
-  const S reach = m.hs * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
+  const S reach = m.period * (numeric::max_of(std::fabs(rd0), std::fabs(rd1)) + std::fabs(rd1 - rd0)) + dm.round_tol;
   const S lo = numeric::min_of(r0, r1) - reach, hi = numeric::max_of(r0, r1) + reach;
   return lo > dm.clear_lo && hi < dm.clear_hi;
 }
@@ -147,7 +147,7 @@ VINES_INLINE bool clear_of_walls(const Model<S, N, Dev>& m, S r0, S rd0, S r1, S
 template <typename S, int N, typename Dev>
 VINES_INLINE bool may_touch(const Model<S, N, Dev>& m, S r0, S rd0, S r1, S rd1) {
   const auto& dm = m.dev;
-  const S h = m.hs;
+  const S h = m.period;
   if (VINES_LIKELY(clear_of_walls(m, r0, rd0, r1, rd1))) return false;
   const S margin = S(0.25) * h * std::fabs(rd1 - rd0) + dm.round_tol;
   const auto left = numeric::Cubic<S>::make(dm.wall_left - r0, -rd0, dm.wall_left - r1, -rd1, h);
@@ -175,7 +175,7 @@ template <typename S, int N, typename Dev>
 VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typename Model<S, N, Dev>::VecX* zs,
                                const StepRead<S>* rs, const S* as, int n) {
   if (!m.ee_lyapunov || !c.ee_open) return 0;
-  const S h = m.hs, peak = c.peak_top;
+  const S h = m.period, peak = c.peak_top;
   // What a step hands the next: the particle (s, s') and relative to the
   // floor (r, r'), the top floor's |x| and |v|. Two sets, a step reading one
   // and writing the other, so that the loop needs no register moves.
@@ -267,7 +267,7 @@ void keep_extras(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename M
     if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, sd0, a0, a1);
   }
   if (m.loop.floor_peaks)
-    update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.hs, d.peak_x, d.peak_drift);
+    update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.period, d.peak_x, d.peak_drift);
 }
 
 }  // namespace detail

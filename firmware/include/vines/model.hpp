@@ -65,7 +65,7 @@ struct DeviceModel<S, VinesDevice<L>> {
   S m, m_star, inv_m;
   S wall_left, wall_right;  // in the particle coordinate s (see below)
   S y0, v0;                 // initial position (from the box centre) and velocity
-  S c;                      // Hertz prefactor, for the stored contact energy
+  S c;                      // Hertz prefactor (reports and the image; the law's kernel has its own)
   S eps;
   // The law's kernel (contact_laws.hpp; unused for the instantaneous law).
   typename LawOf<L>::template Kernel<S> law;
@@ -108,7 +108,7 @@ struct Model {
   LoopParams loop;
   double h = 0;          // sensor period [s]
   int floor = N - 1;     // device floor, 0-based
-  S hs = S(0);           // h in S
+  S period = S(0);       // h in S
 
   // Exact step and exact step integrals of the linear part.
   LtiT lti;
@@ -163,8 +163,8 @@ struct Model {
 // Sets the device's initial conditions (TMD: x0, v0; VI NES: where the
 // particle starts, its speed, and the wall coordinates and tolerances that
 // follow from where it starts) in a model built from the same parameters
-// otherwise: the model is then the one build_model makes from `dev`, bit for
-// bit (build_model ends with this call). Finiteness is validate()'s; returns
+// otherwise: the model is then the one build_model (build_model.hpp) makes
+// from `dev`, bit for bit (build_model ends with this call). Finiteness is validate()'s; returns
 // the first problem found. Needs only the device design and md.loop, so a
 // model loaded from an image can take new initial conditions too.
 template <typename S, int N, typename Dev>
@@ -197,204 +197,5 @@ ParamError set_initial_conditions(const DeviceParams& dev, Model<S, N, Dev>* out
   }
   return {};
 }
-
-#if VINES_MODEL_REPORT
-namespace detail {
-
-// Physical matrices over the P position coordinates: mass, frame stiffness,
-// device spring, damping (frame dashpots and the TMD's).
-template <int P>
-struct Physical {
-  Eigen::Matrix<double, P, P> m, k_frame, k_device, c;
-};
-
-template <int NX>
-Eigen::Matrix<double, NX + 1, NX + 1> zz_form(const Eigen::Matrix<double, NX, NX>& q) {
-  Eigen::Matrix<double, NX + 1, NX + 1> out = Eigen::Matrix<double, NX + 1, NX + 1>::Zero();
-  out.template topLeftCorner<NX, NX>() = q;
-  return out;
-}
-
-}  // namespace detail
-
-// Builds the model in place (it can be large: keep it static). Returns the
-// first problem found; the model is usable only when the result is ok().
-template <typename S, int N, typename Dev>
-ParamError build_model(const SceneParams& p, Model<S, N, Dev>* out) {
-  using M = Model<S, N, Dev>;
-  constexpr int NX = M::kNx, P = M::kP;
-  Model<S, N, Dev>& md = *out;
-
-  ParamError err = validate(p);
-  if (!err.ok()) return err;
-  if (p.frame.stories != N) return {"frame.stories", "does not match the compiled frame size"};
-  if (p.device.kind != Dev::kKind) return {"device.kind", "does not match the compiled device"};
-  if constexpr (Dev::kKind == DeviceKind::kVines) {
-    if (p.device.vines.law != Dev::kLaw)
-      return {"vines.law", "does not match the compiled contact law"};
-  }
-
-  // Frame as simulated (damage applied) and nominal (devices are designed on it).
-  md.frame = build_frame<N>(p.frame);
-  md.modal = modal_analysis(md.frame);
-  md.nominal_modal = modal_analysis(build_frame<N>(undamaged(p.frame)));
-  md.loop = p.loop;
-  md.h = 1.0 / p.loop.sensor_rate_hz;
-  md.hs = static_cast<S>(md.h);
-  md.floor = p.device.floor > 0 ? p.device.floor - 1 : N - 1;
-  const double device_mass = p.device.mass_kg > 0.0
-                                 ? p.device.mass_kg
-                                 : p.device.mass_ratio * md.nominal_modal.m_eff(0);
-  const double floor_mass = md.frame.m(md.floor);
-
-  // Rayleigh damping fitted on two modes, zeta(w) = a0 / (2w) + a1 w / 2, goes
-  // negative on the other modes when a1 < 0 or a0 < 0: they would grow
-  // without bound, so the frame is refused (beyond rounding).
-  for (int j = 0; j < N; ++j)
-    if (p.frame.damping == DampingRule::kRayleigh && md.modal.zeta(j) < -1e-9)
-      return {"frame.rayleigh_zeta",
-              "gives another mode a negative damping ratio (its response would grow without "
-              "bound): zeta2 / zeta1 must lie between w1 / w2 and w2 / w1 of the two modes"};
-
-  // Classical damping is what makes the modal blocks exact: check it.
-  if constexpr (M::kModal) {
-    const Eigen::Matrix<double, N, N> cm = md.modal.phi.transpose() * md.frame.C * md.modal.phi;
-    const double diag = cm.diagonal().cwiseAbs().maxCoeff();
-    if ((cm - Eigen::Matrix<double, N, N>(cm.diagonal().asDiagonal())).cwiseAbs().maxCoeff() >
-        1e-8 * (diag > 0.0 ? diag : 1.0))
-      return {"frame.damping", "is not classical (modal coordinates would not decouple)"};
-  }
-
-  // Physical matrices over the position coordinates (TMD adds one).
-  detail::Physical<P> ph;
-  ph.m.setZero();
-  ph.k_frame.setZero();
-  ph.k_device.setZero();
-  ph.c.setZero();
-  ph.m.template topLeftCorner<N, N>() = md.frame.m.asDiagonal();
-  ph.k_frame.template topLeftCorner<N, N>() = md.frame.K;
-  ph.c.template topLeftCorner<N, N>() = md.frame.C;
-
-  // Continuous-time linear part, and maps from z to positions and velocities.
-  LtiSpec<NX> spec;
-  spec.a.setZero();
-  spec.bg.setZero();
-  spec.bf.setZero();
-  Eigen::Matrix<double, P, NX> px = Eigen::Matrix<double, P, NX>::Zero(), pv = px;
-  if constexpr (Dev::kKind == DeviceKind::kTmd) {
-    const TmdDesign t = design_tmd(p.device.tmd, device_mass, md.nominal_modal.m_eff(0),
-                                   md.nominal_modal.omega(0));
-    md.dev.design = t;
-    const int f = md.floor, d = N;
-    ph.m(d, d) = t.mass;
-    ph.k_device(f, f) = ph.k_device(d, d) = t.k;
-    ph.k_device(f, d) = ph.k_device(d, f) = -t.k;
-    ph.c(f, f) += t.c;
-    ph.c(d, d) += t.c;
-    ph.c(f, d) -= t.c;
-    ph.c(d, f) -= t.c;
-    const Eigen::Matrix<double, P, P> minv = ph.m.diagonal().cwiseInverse().asDiagonal();
-    spec.a.template topRightCorner<P, P>().setIdentity();
-    spec.a.template bottomLeftCorner<P, P>() = -minv * (ph.k_frame + ph.k_device);
-    spec.a.template bottomRightCorner<P, P>() = -minv * ph.c;
-    spec.bg.template tail<P>().setConstant(-1.0);
-    px.template leftCols<P>().setIdentity();
-    pv.template rightCols<P>().setIdentity();
-    md.pos_map.setZero();
-    md.pos_map.template leftCols<N>().setIdentity();
-  } else {
-    const Modal<N>& mo = md.modal;
-    for (int j = 0; j < N; ++j) {
-      const double w = mo.omega(j);
-      spec.a(j, P + j) = 1.0;
-      spec.a(P + j, j) = -w * w;
-      spec.a(P + j, P + j) = -2.0 * mo.zeta(j) * w;
-      spec.bg(P + j) = -mo.gamma(j);
-      spec.bf(P + j) = mo.phi(md.floor, j);
-      px.col(j).template head<N>() = mo.phi.col(j);
-      pv.col(P + j).template head<N>() = mo.phi.col(j);
-    }
-    // Padding modes j >= N: no coupling, no input, zero rows: they stay 0.
-    md.pos_map.setZero();
-    md.pos_map.template leftCols<N>() = mo.phi.template cast<S>();
-  }
-  md.rows.top = md.pos_map.row(N - 1).transpose();
-  md.rows.dev = md.pos_map.row(md.floor).transpose();
-  md.rows.bound = md.pos_map.cwiseAbs().colwise().maxCoeff().transpose();
-  md.rows.dev_is_top = md.floor == N - 1;
-  if constexpr (M::kModal) md.lti = discretise_modal<S, P>(spec, md.h);
-  else md.lti = discretise_dense<S, NX>(spec, md.h);
-  md.top_acc_z = pv.row(N - 1).lazyProduct(spec.a).transpose().template cast<S>();
-  md.top_acc_ag = static_cast<S>(pv.row(N - 1).dot(spec.bg));
-
-  // Energies and powers as quadratic forms in [z; a_g].
-  using QX = Eigen::Matrix<double, NX, NX>;
-  const auto q_kin = detail::zz_form<NX>(QX(0.5 * pv.transpose() * ph.m * pv));
-  const auto q_strain = detail::zz_form<NX>(QX(0.5 * px.transpose() * ph.k_frame * px));
-  const auto q_devpot = detail::zz_form<NX>(QX(0.5 * px.transpose() * ph.k_device * px));
-  const auto q_damp = detail::zz_form<NX>(QX(pv.transpose() * ph.c * pv));
-  // Input power -a_g (sum of m v) as a bilinear form: off-diagonal halves.
-  Eigen::Matrix<double, NX + 1, NX + 1> q_in = Eigen::Matrix<double, NX + 1, NX + 1>::Zero();
-  const Eigen::Matrix<double, NX, 1> mv = pv.transpose().lazyProduct(ph.m.diagonal());
-  q_in.template block<NX, 1>(0, NX) = -0.5 * mv;
-  q_in.template block<1, NX>(NX, 0) = -0.5 * mv.transpose();
-
-  auto form = [](const auto& q) {
-    if constexpr (M::kModal) return form_modal<S, P>(q);
-    else return form_dense<S, NX>(q);
-  };
-  auto integral = [&](const auto& q) {
-    if constexpr (M::kModal) return quad_integral_modal<S, P>(spec, q, md.h);
-    else return quad_integral_dense<S, NX>(spec, q, md.h);
-  };
-  md.kinetic = form(q_kin);
-  md.strain = form(q_strain);
-  md.device_potential = form(q_devpot);
-  md.damping_power = form(q_damp);
-  md.input_power = form(q_in);
-  md.strain_step = integral(q_strain);
-  if constexpr (M::kModal) md.ee_lyapunov = lyapunov_split<S, P>(spec, q_strain, md.h, &md.rows, &md.ee_boundary);
-  if (p.loop.energy_ledger) {
-    md.input_step = integral(q_in);
-    md.damping_step = integral(q_damp);
-  }
-
-  const Eigen::Matrix<double, N, 1> minv_frame = md.frame.m.cwiseInverse();
-  md.minv_k = (minv_frame.asDiagonal() * md.frame.K).template cast<S>();
-  md.minv_c = (minv_frame.asDiagonal() * md.frame.C).template cast<S>();
-  md.inv_floor_mass = static_cast<S>(1.0 / floor_mass);
-
-  if constexpr (Dev::kKind == DeviceKind::kVines) {
-    const VinesParams& vp = p.device.vines;
-    const VinesDesign d = design_vines(vp, device_mass, floor_mass);
-    if (!d.ok)
-      return {"vines.eps",
-              "tau could not be calibrated for this eps and v_ref with these masses (the sphere's: "
-              "device.mass_ratio or mass_kg, vines.radius_m; its floor's: frame.masses_kg)"};
-    if (!(d.gap > 0.0)) return {"vines.box_length_m", "must be longer than the sphere diameter"};
-    auto& dm = md.dev;
-    dm.design = d;
-    dm.m = static_cast<S>(d.mass);
-    dm.inv_m = static_cast<S>(1.0 / d.mass);
-    dm.m_star = static_cast<S>(d.m_star);
-    dm.c = static_cast<S>(d.c);
-    dm.eps = static_cast<S>(d.eps);
-    dm.law = LawOf<Dev::kLaw>::template kernel<S>(d);
-    const double v_scale = vp.v_ref_mps > 0.0 ? vp.v_ref_mps : 0.5;
-    dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));
-    dm.vel_scale = static_cast<S>(v_scale);
-    dm.modal_scale = static_cast<S>(std::sqrt(md.frame.m.sum()));
-    dm.q_scale = static_cast<S>(std::pow(static_cast<double>(dm.pos_scale), 0.25));
-    dm.ff_a0 = static_cast<S>(md.h * md.h / 3.0);
-    dm.ff_a1 = static_cast<S>(md.h * md.h / 6.0);
-    dm.ff_v = static_cast<S>(md.h / 2.0);
-    dm.w_step0 = static_cast<S>(0.02 * std::pow(static_cast<double>(dm.pos_scale), 0.25) / v_scale);
-    const double resolution = 256.0 * std::numeric_limits<S>::epsilon() * 2.0 * d.gap;
-    dm.count_depth = static_cast<S>(std::fmax(p.loop.contact_count_depth_m, resolution));
-  }
-  return set_initial_conditions(p.device, out);
-}
-
-#endif  // VINES_MODEL_REPORT
 
 }  // namespace vines

@@ -58,8 +58,8 @@ template <typename S, int N, typename Dev>
 VINES_INLINE S top_peak_of_step(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z0,
                                 const typename Model<S, N, Dev>::VecX& z1, S a0, S a1, S x0, S v0, S x1, S v1,
                                 S peak) {
-  if (!VINES_UNLIKELY(top_bound(x0, v0, x1, v1, m.hs) > peak)) return S(0);
-  return numeric::quintic_abs_max(x0, v0, m.top_a(z0, a0), x1, v1, m.top_a(z1, a1), m.hs);
+  if (!VINES_UNLIKELY(top_bound(x0, v0, x1, v1, m.period) > peak)) return S(0);
+  return numeric::quintic_abs_max(x0, v0, m.top_a(z0, a0), x1, v1, m.top_a(z1, a1), m.period);
 }
 
 // Peak of the top floor over a sub-step of length h (cubic Hermite).

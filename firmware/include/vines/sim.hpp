@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "vines/build_model.hpp"
 #include "vines/data.hpp"
 #include "vines/exact_step.hpp"
 #include "vines/model.hpp"
@@ -83,7 +84,7 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
   d.peak_drift.setZero();
   d.peak_top = std::fabs(d.xt);
   d.peak_top_velocity = std::fabs(d.vt);
-  d.substep = m.hs;
+  d.substep = m.period;
   if (m.loop.energy_ledger) {
     detail::close_ledger(m, d);  // the energy stored by the initial conditions
     d.ledger.initial = d.ledger.kinetic + d.ledger.strain + d.ledger.device;

@@ -40,16 +40,15 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   constexpr int NX = Model<S, N, Dev>::kNx;
   using Stepper = detail::SubStepper<S, N, Dev>;
   using Vec = typename Stepper::Vec;
-  constexpr int kT = Stepper::kT, kQ = Stepper::kQ;
+  constexpr int kT = Stepper::kT;
   const auto& dm = m.dev;
-  const S h = m.hs;
+  const S h = m.period;
   constexpr S kEps = std::numeric_limits<S>::epsilon();
-  // Tolerances that the scalar can honour.
-  const S rtol = std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * kEps);
+  const S rtol = detail::contact_rtol(m);
   const int cap = m.loop.max_substeps_per_step;
   // q and the overlap agree within rtol * pos_scale (they are put back
-  // together past that, below): a contact ends where q reaches zero with no
-  // more overlap left than that (apply_event).
+  // together past that, resync_q): a contact ends where q reaches zero with
+  // no more overlap left than that (apply_event).
   const S end_tol = numeric::max_of(dm.event_tol, rtol * dm.pos_scale);
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
@@ -69,12 +68,9 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     // An event already due at the start of the sub-step (the state sits on
     // the far side of a switching surface within rounding): apply it now.
     if (immediate < 4) {
-      const int due = due_event(m, st, y);
-      if (due != 0) {
+      const bool was_regular = st.regular();
+      if (detail::apply_due_event(m, d, st, y, end_tol) != 0) {
         ++immediate;
-        ++d.count.events;
-        const bool was_regular = st.regular();
-        apply_event(m, d, st, y, due, end_tol);
         if (st.regular() && !was_regular) hc_w = dm.w_step0;
         f = st(u, y);
         continue;
@@ -82,16 +78,16 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
     const bool reg = st.regular();
     const bool forced = n >= cap - 1;
-    S hs;
-    if (!reg) hs = std::fmin(hc_t, h - y(kT));
-    else if (forced) hs = (h - y(kT)) / std::fmax(f(kT), kEps);  // to t = h at the current rate
-    else hs = hc_w;
-    auto r = numeric::dopri5_step<Vec>(st, u, y, f, hs);
+    S du;
+    if (!reg) du = std::fmin(hc_t, h - y(kT));
+    else if (forced) du = (h - y(kT)) / std::fmax(f(kT), kEps);  // to t = h at the current rate
+    else du = hc_w;
+    auto r = numeric::dopri5_step<Vec>(st, u, y, f, du);
     const S en = st.error_norm(r.err, y, r.y, rtol, rtol_scale);
     ++n;
     if (!forced && !control.accepts(en)) {
       ++d.count.rejected;
-      (reg ? hc_w : hc_t) = control.rejected(hs, en);
+      (reg ? hc_w : hc_t) = control.rejected(du, en);
       continue;
     }
     if (forced) capped = true;
@@ -102,12 +98,12 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     // times (6e-8 of it).
     S theta = S(2);
     int side = 0;
-    const bool any = !forced && detail::first_event(m, st, y, f, r.y, r.f, hs, h, 20, &theta, &side);
+    const bool any = !forced && detail::first_event(m, st, y, f, r.y, r.f, du, h, 20, &theta, &side);
 
     if (any && theta <= S(1)) {
       // Place the event on the true sub-step (detail::locate_event).
       S tau;
-      const auto rr = detail::locate_event(m, st, u, y, f, r, hs, h, theta, side, rtol, &tau);
+      const auto rr = detail::locate_event(m, st, u, y, f, r, du, h, theta, side, rtol, &tau);
       // Accept up to the event.
       track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), d.time(m) + static_cast<double>(rr.y(kT)));
       u += tau;
@@ -118,7 +114,6 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
         y(kT) = h;
         break;
       }
-      ++d.count.events;
       const bool was_regular = st.regular();
       apply_event(m, d, st, y, side, end_tol);
       if (st.regular() && !was_regular) hc_w = dm.w_step0;
@@ -128,23 +123,13 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
 
     // Plain accepted sub-step.
     track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), d.time(m) + static_cast<double>(r.y(kT)));
-    u += hs;
+    u += du;
     y = r.y;
     f = r.f;
-    if (reg) {
-      // q^4 and the overlap drift apart over a long (resting) contact: put q
-      // back on the overlap once they differ by more than the tolerance.
-      const S r_now = st.rel_pos(y);
-      const S dl = std::fmax(st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r_now) : overlap_right<S>(dm, r_now), S(0));
-      const S q2 = y(kQ) * y(kQ);
-      if (std::fabs(q2 * q2 - dl) > rtol * dm.pos_scale) {
-        y(kQ) = std::sqrt(std::sqrt(dl));
-        f = st(u, y);
-      }
-    }
+    if (reg && detail::resync_q(m, st, y, rtol * dm.pos_scale)) f = st(u, y);
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
-    (reg ? hc_w : hc_t) = control.accepted(hs, en);
+    (reg ? hc_w : hc_t) = control.accepted(du, en);
     if (forced || y(kT) >= h * (S(1) - S(8) * kEps)) break;
   }
   if (capped) ++d.count.cap_hits;

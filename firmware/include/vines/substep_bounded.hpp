@@ -195,13 +195,13 @@ ContactAim<S> predict_contact(const Model<S, N, Dev>& m, const Stepper& st, cons
   return out;
 }
 
-// The sub-step [y0 (f0) -> y1 (f1), length hs]: the state at theta on its
+// The sub-step [y0 (f0) -> y1 (f1), length du]: the state at theta on its
 // cubic Hermite interpolant, with its bookkeeping (track_substep).
 template <typename S, int N, typename Dev, typename Vec>
 Vec interpolate_to(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0, const Vec& f0,
-                   const Vec& y1, const Vec& f1, S hs, S theta) {
+                   const Vec& y1, const Vec& f1, S du, S theta) {
   constexpr int kT = Model<S, N, Dev>::kNx + 6;
-  const Vec y = numeric::hermite_point(y0, f0, y1, f1, hs, theta);
+  const Vec y = numeric::hermite_point(y0, f0, y1, f1, du, theta);
   track_substep(m, d, mode, y0, y, y(kT) - y0(kT), d.time(m) + static_cast<double>(y(kT)), false);
   return y;
 }
@@ -216,18 +216,17 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   constexpr int NX = Model<S, N, Dev>::kNx;
   using Stepper = detail::SubStepper<S, N, Dev>;
   using Vec = typename Stepper::Vec;
-  constexpr int kT = Stepper::kT, kQ = Stepper::kQ;
+  constexpr int kT = Stepper::kT;
   constexpr S kInf = std::numeric_limits<S>::infinity();
   const auto& dm = m.dev;
-  const S h = m.hs;
+  const S h = m.period;
   const int budget = m.loop.bounded_substeps;
   const S margin = S(1) + static_cast<S>(detail::kAimMargin);
   // A contact ends where q returns to zero if the walls overlap by no more
   // than this (what the interpolant leaves), else q is set back on the
   // overlap (apply_event).
   const S end_tol = numeric::max_of(dm.event_tol, S(1e-6) * dm.pos_scale);
-  const S sync_tol = numeric::max_of(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon()) *
-                     dm.pos_scale;
+  const S sync_tol = detail::contact_rtol(m) * dm.pos_scale;  // q against the overlap (resync_q)
 
   Stepper st{m, a0, (a1 - a0) / h, d.mode};
   Vec y = detail::load_state<S, N, Dev, Vec>(d);
@@ -236,14 +235,14 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   bool short_of_budget = false;
   ++d.count.careful_steps;
 
-    // An event may be applied: a contact's end while a slot is left, anything
+  // An event may be applied: a contact's end while a slot is left, anything
   // else only with a slot left for the end of the contact it may start.
   auto may_apply = [&] { return in_contact(st.mode) ? events < kBoundedEvents : events + 2 <= kBoundedEvents; };
+  // The last slot must end the contact.
+  auto slot_end_tol = [&] { return events + 1 == kBoundedEvents ? kInf : end_tol; };
   auto apply = [&](int side) {
+    apply_event(m, d, st, y, side, slot_end_tol());
     ++events;
-    ++d.count.events;
-    // The last slot must end the contact.
-    apply_event(m, d, st, y, side, events == kBoundedEvents ? kInf : end_tol);
     f = st(S(0), y);
   };
   // The rest of the step when no sub-step is left for it: free flight (a
@@ -260,12 +259,10 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
 
   while (y(kT) < h) {
     // 1. An event due before any time passes (see due_event).
-    if (may_apply()) {
-      const int due = due_event(m, st, y);
-      if (due != 0) {
-        apply(due);
-        continue;
-      }
+    if (may_apply() && detail::apply_due_event(m, d, st, y, slot_end_tol()) != 0) {
+      ++events;
+      f = st(S(0), y);
+      continue;
     }
     if (taken == budget) {  // only after an event in the last sub-step
       finish_without_substep();
@@ -274,27 +271,27 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     // 2. Aim the sub-step.
     const int left = budget - taken;
     const bool reg = st.regular();
-    S hs;
+    S du;
     bool to_end = false;  // a free sub-step that ends the step exactly
     if (!reg) {
       const S span = h - y(kT);
       const S start = st.mode == Mode::kFree && left >= 2 && events + 2 <= kBoundedEvents
                           ? detail::predict_start(m, st, y, f, span)
                           : S(0);
-      hs = start > S(0) ? numeric::min_of(start * margin, span) : span;
-      to_end = hs == span;
+      du = start > S(0) ? numeric::min_of(start * margin, span) : span;
+      to_end = du == span;
     } else {
       const detail::ContactAim<S> aim = detail::predict_contact(m, st, y, f, h - y(kT));
       const bool end_first = aim.w_end < kInf && left >= 2;
       const S target = end_first ? aim.w_end : aim.w_step;
       const int share = end_first ? left - 1 : left;
-      hs = target / static_cast<S>(share);
-      if (share == 1) hs *= margin;
-      if (!(hs > S(0) && hs < kInf)) hs = dm.w_step0;  // no prediction: a first step's size
-      hs = numeric::min_of(hs, aim.w_max);
+      du = target / static_cast<S>(share);
+      if (share == 1) du *= margin;
+      if (!(du > S(0) && du < kInf)) du = dm.w_step0;  // no prediction: a first step's size
+      du = numeric::min_of(du, aim.w_max);
     }
     // 3. The sub-step.
-    const auto r = numeric::dopri5_step<Vec, false>(st, S(0), y, f, hs);
+    const auto r = numeric::dopri5_step<Vec, false>(st, S(0), y, f, du);
     ++taken;
     ++d.count.substeps;
     if (st.mode != Mode::kFree) ++d.count.contact_substeps;
@@ -302,17 +299,17 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     // 4. The first event inside it, if the budget can follow it.
     S theta = S(2);
     int side = 0;
-    const bool any = detail::first_event(m, st, y, f, r.y, r.f, hs, h, 20, &theta, &side) && theta <= S(1);
+    const bool any = detail::first_event(m, st, y, f, r.y, r.f, du, h, 20, &theta, &side) && theta <= S(1);
     const bool step_end = any && side == 0;
     if (any && (step_end || (may_apply() && (reg || taken < budget)))) {
       if (!riding(st.mode)) {
         S s0, s1;
         const S g0 = detail::event_value(m, st, y, f, side, h, &s0);
         const S g1 = detail::event_value(m, st, r.y, r.f, side, h, &s1);
-        const auto c = numeric::Cubic<S>::make(g0, s0, g1, s1, hs);
+        const auto c = numeric::Cubic<S>::make(g0, s0, g1, s1, du);
         theta = detail::polish_root<detail::kBoundedRootIterations>(c, theta, S(0), S(1));
       }
-      y = detail::interpolate_to(m, d, st.mode, y, f, r.y, r.f, hs, theta);
+      y = detail::interpolate_to(m, d, st.mode, y, f, r.y, r.f, du, theta);
       if (step_end) {
         y(kT) = h;
         break;
@@ -329,27 +326,18 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     f = r.f;
     if (to_end) y(kT) = h;
     if (reg) {
-      // q^4 and the overlap drift apart: put q back on the overlap (as
-      // substep_through does).
-      const S r_now = st.rel_pos(y);
-      const S dl = numeric::max_of(
-          st.mode == Mode::kContactLeft ? overlap_left<S>(dm, r_now) : overlap_right<S>(dm, r_now), S(0));
-      const S q2 = y(kQ) * y(kQ);
-      if (std::fabs(q2 * q2 - dl) > sync_tol) {
-        y(kQ) = std::sqrt(std::sqrt(dl));
-        f = st(S(0), y);
-      }
+      if (detail::resync_q(m, st, y, sync_tol)) f = st(S(0), y);
       if (taken == budget && y(kT) < h) {
         // Out of sub-steps short of the step's end: extrapolate to it on the
         // last sub-step's interpolant (Newton on its cubic of t from theta =
         // 1) if it gets there soon enough, else end the step here.
         const S reach = static_cast<S>(detail::kMaxExtrapolation);
-        const auto c = numeric::Cubic<S>::make(y0(kT) - h, f0(kT), y(kT) - h, f(kT), hs);
+        const auto c = numeric::Cubic<S>::make(y0(kT) - h, f0(kT), y(kT) - h, f(kT), du);
         if (c.value(reach) > S(0)) {
           short_of_budget = true;
           const S th = detail::polish_root<detail::kBoundedRootIterations>(c, S(1), S(1), reach);
           const Vec y1 = y;
-          y = numeric::hermite_point(y0, f0, y1, f, hs, th);
+          y = numeric::hermite_point(y0, f0, y1, f, du, th);
           y(kT) = h;
           track_substep(m, d, st.mode, y1, y, h - y1(kT), d.time(m) + static_cast<double>(h), false);
         } else {

@@ -22,13 +22,13 @@
 
 namespace vines {
 
-// Elastic energy stored in the current contact, (2/5) C d^{5/2}.
+// Elastic energy stored in the current contact (the law's potential).
 template <typename S, int N, typename Dev>
 S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
   if (!in_contact(d.mode)) return S(0);
   const S r = d.s - m.dev_x(d.z);
   const S dl = d.mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r);
-  return dl > S(0) ? S(0.4) * m.dev.c * dl * dl * std::sqrt(dl) : S(0);
+  return dl > S(0) ? m.dev.law.potential(dl) : S(0);
 }
 
 // Exact free flight of the particle over one step (acceleration -a_g, linear
@@ -36,7 +36,7 @@ S contact_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
 template <typename S, int N, typename Dev>
 VINES_INLINE void free_flight(const Model<S, N, Dev>& m, S s, S sd, S a0, S a1, S* s1, S* sd1) {
   const auto& dm = m.dev;
-  *s1 = s + sd * m.hs - a0 * dm.ff_a0 - a1 * dm.ff_a1;
+  *s1 = s + sd * m.period - a0 * dm.ff_a0 - a1 * dm.ff_a1;
   *sd1 = sd - (a0 + a1) * dm.ff_v;
 }
 
@@ -44,7 +44,7 @@ VINES_INLINE void free_flight(const Model<S, N, Dev>& m, S s, S sd, S a0, S a1, 
 // a = a0 + al t, v = v0 - a0 t - al t^2 / 2.
 template <typename S, int N, typename Dev>
 double free_flight_work(const Model<S, N, Dev>& m, S v0, S a0, S a1) {
-  const S h = m.hs, al = (a1 - a0) / h;
+  const S h = m.period, al = (a1 - a0) / h;
   const S h2 = h * h, h3 = h2 * h, h4 = h3 * h;
   const S w = a0 * v0 * h - a0 * a0 * h2 / S(2) - a0 * al * h3 / S(6) + al * v0 * h2 / S(2) -
               al * a0 * h3 / S(3) - al * al * h4 / S(8);
@@ -86,7 +86,7 @@ struct SubStepper {
     if (rate) *rate = S(0);
     const auto& dm = m.dev;
     if (regular()) {
-      if constexpr (Dev::kLaw != ContactLaw::kRestitution) {
+      if constexpr (!Dev::kImpulsive) {
         const S ddl = overlap_rate(y);
         const contact::Force<S> f = dm.law.regular(y(kQ), ddl);
         *fp = mode == Mode::kContactLeft ? f.total() : -f.total();
@@ -161,7 +161,7 @@ struct SubStepper {
     const auto ey = e.template head<NX + 2>().array().abs();
     const auto mag = y0.template head<NX + 2>().array().abs().max(y1.template head<NX + 2>().array().abs());
     const S worst = (ey / (rtol_scale + rtol * mag)).maxCoeff();
-    const S rt = std::fabs(e(kT)) / (rtol * m.hs);
+    const S rt = std::fabs(e(kT)) / (rtol * m.period);
     const S rq = regular() ? std::fabs(e(kQ)) / (rtol * m.dev.q_scale) : S(0);
     const S all = numeric::max_of(worst, numeric::max_of(rt, rq));
     return std::isfinite(all + ey.sum()) ? all : std::numeric_limits<S>::infinity();
@@ -208,7 +208,7 @@ struct EventAct {
 
   // Newton's law between the particle and the floor mass (Eq. 4).
   Impact impact(int side) {
-    if constexpr (Dev::kLaw == ContactLaw::kRestitution) {
+    if constexpr (Dev::kImpulsive) {
       constexpr int NX = Model<S, N, Dev>::kNx;
       using VecX = typename Model<S, N, Dev>::VecX;
       const auto& dm = m.dev;
@@ -276,20 +276,52 @@ struct EventAct {
 
 }  // namespace detail
 
-// What happens at a located event (side: -1 left wall, +1 right wall): the
-// contact-mode transition with the sub-stepper's actions (detail::EventAct).
-// Out of line: a rare path that both sub-steppers call from several places.
+// What happens at a located event (side: -1 left wall, +1 right wall): it is
+// counted, and the contact-mode transition takes place with the
+// sub-stepper's actions (detail::EventAct). Out of line: a rare path that
+// both sub-steppers call from several places.
 template <typename S, int N, typename Dev, typename Stepper, typename Vec>
 VINES_NOINLINE void apply_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, int side, S end_tol) {
 #ifdef VINES_TRACE
   std::printf("event t=%.6f mode=%d side=%d r=%.6e rd=%.6e depth=%.3e\n", d.time(m), (int)st.mode, side,
               (double)st.rel_pos(y), (double)st.rel_vel(y), (double)d.contact_depth);
 #endif
+  ++d.count.events;
   detail::EventAct<S, N, Dev, Stepper, Vec> act{m, d, st, y, end_tol};
-  take_event(st.mode, side, Dev::kLaw == ContactLaw::kRestitution, act);
+  take_event(st.mode, side, Dev::kImpulsive, act);
 }
 
 namespace detail {
+
+// The relative tolerance of contacts that the scalar can honour.
+template <typename S, int N, typename Dev>
+S contact_rtol(const Model<S, N, Dev>& m) {
+  return std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
+}
+
+// An event due before any time passes (due_event), applied (apply_event):
+// its wall side, 0 if none.
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+int apply_due_event(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Stepper& st, Vec& y, S end_tol) {
+  const int due = due_event(m, st, y);
+  if (due != 0) apply_event(m, d, st, y, due, end_tol);
+  return due;
+}
+
+// In a contact, q^4 and the overlap drift apart (most over a long, resting
+// contact): q is put back on the overlap once they differ by more than tol.
+// True if it was (the state's derivative is then stale).
+template <typename S, int N, typename Dev, typename Stepper, typename Vec>
+bool resync_q(const Model<S, N, Dev>& m, const Stepper& st, Vec& y, S tol) {
+  constexpr int kQ = Stepper::kQ;
+  const S r = st.rel_pos(y);
+  const S dl = numeric::max_of(
+      st.mode == Mode::kContactLeft ? overlap_left<S>(m.dev, r) : overlap_right<S>(m.dev, r), S(0));
+  const S q2 = y(kQ) * y(kQ);
+  if (!(std::fabs(q2 * q2 - dl) > tol)) return false;
+  y(kQ) = std::sqrt(std::sqrt(dl));
+  return true;
+}
 
 // The sub-steppers' state vector from the data block: floors (modal), the
 // particle, four zeroed integrals (contact loss, input, damping, E_e), time

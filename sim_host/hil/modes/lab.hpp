@@ -33,7 +33,7 @@ struct LabOptions {
 struct Specimen {
   DeviceKind kind = DeviceKind::kVines;  // kVines or kTmd
   VinesDesign vines;
-  ContactLaw law = ContactLaw::kKuwabara;
+  ContactLaw law = VinesParams{}.law;  // the scene's default
   TmdDesign tmd;
   double x0 = 0, v0 = 0;
 };

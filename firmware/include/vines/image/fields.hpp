@@ -52,7 +52,7 @@ constexpr void visit_fields(V& v) {
 
   v(all, &M::h);
   v(all, &M::floor);
-  v(all, &M::hs);
+  v(all, &M::period);
 
   // Exact step of the linear part.
   if constexpr (M::kModal) {

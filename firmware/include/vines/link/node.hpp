@@ -31,11 +31,11 @@
 #include <cstdint>
 #include <limits>
 
-#include "vines/link/ats.hpp"
 #include "vines/link/config.hpp"
-#include "vines/link/extrapolate.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/link/mode_outputs.hpp"
+#include "vines/link/status_text.hpp"
 #include "vines/validate.hpp"
 
 namespace vines::link {
@@ -192,7 +192,7 @@ class Node {
     else why = validate_node(cfg);
     const ParamError scene = why ? ParamError{} : validate(cfg.scene);
     if (why) copy_message(why);
-    else if (!scene.ok()) why = describe(scene);
+    else if (!scene.ok()) why = describe(scene, status_.message, sizeof status_.message);
     else if (!plant_->configure(cfg, status_.message, sizeof status_.message)) why = status_.message;
     if (why) {
       fault(FaultCode::kConfig, 0, 1);
@@ -245,9 +245,7 @@ class Node {
     offset_ = local_ ? static_cast<std::int64_t>(s.t_ns) - static_cast<std::int64_t>(local_) : 0;
     last_rx_ns_ = s.t_ns;
     filled_ = 0;
-    ms_residual_ = 0;
-    hist_n_ = 0;
-    ats_.reset(h_, cfg_.comp_window_s, cfg_.comp_delay_s);
+    outputs_.reset(cfg_, h_);
     send_status();
   }
 
@@ -323,41 +321,9 @@ class Node {
     t.rx = status_.rx;
     t.ag = a;
     t.flags = static_cast<std::uint16_t>(t.flags | flags);
-    if (cfg_.mode == NodeMode::kTwin) twin(&t, aux, (flags & kAuxMissing) == 0);
-    if (cfg_.mode == NodeMode::kHybrid) t.aux = command(t.x[t.n - 1], xm, &t);
+    if (cfg_.mode == NodeMode::kTwin) outputs_.twin(cfg_, h_, &t, aux, (flags & kAuxMissing) == 0);
+    if (cfg_.mode == NodeMode::kHybrid) t.aux = outputs_.command(cfg_, h_, t.x[t.n - 1], xm, &t);
     send(MsgType::kTelemetry, t);
-  }
-
-  // Twin: residual of the measured top-floor acceleration, its running RMS,
-  // and the drift alarms.
-  void twin(Telemetry* t, double measured, bool have) {
-    t->aux = have ? measured - t->acc_top : 0.0;
-    if (have) ms_residual_ += (t->aux * t->aux - ms_residual_) * std::fmin(1.0, h_ / cfg_.residual_window_s);
-    if (cfg_.residual_limit_mps2 > 0 && std::sqrt(ms_residual_) > cfg_.residual_limit_mps2) t->flags |= kResidualAlarm;
-    for (int i = 0; i < t->n; ++i) {
-      const double drift = t->x[i] - (i ? t->x[i - 1] : 0.0);
-      if (cfg_.drift_limit_m[i] > 0 && !(std::fabs(drift) <= cfg_.drift_limit_m[i])) {
-        t->drift_alarms |= std::uint64_t{1} << i;
-        t->flags |= kDriftAlarm;
-      }
-    }
-  }
-
-  // Hybrid: the table command from the top floor: itself (none), extrapolated
-  // over the delay (polynomial), or the adaptive compensator's, fed the
-  // measured table too (its coefficients into the telemetry).
-  double command(double x_top, double xm, Telemetry* t) {
-    if (cfg_.comp_kind == CompKind::kNone) return x_top;
-    if (cfg_.comp_kind == CompKind::kAdaptive) {
-      const double u = ats_.step(x_top, xm);
-      for (int i = 0; i < 3; ++i) t->comp[i] = ats_.coefficient(i);
-      return u;
-    }
-    for (int i = 3; i > 0; --i) hist_[i] = hist_[i - 1];
-    hist_[0] = x_top;
-    if (hist_n_ < 4) ++hist_n_;
-    const int p = cfg_.comp_order < hist_n_ - 1 ? cfg_.comp_order : hist_n_ - 1;
-    return extrapolate(hist_, p, cfg_.comp_delay_s, h_);
   }
 
   // ---- output -----------------------------------------------------------
@@ -384,33 +350,7 @@ class Node {
     f.count = count;
     send(MsgType::kFault, f);
   }
-  // "field[index]: message" into the status message (no printf on a board).
-  const char* describe(const ParamError& e) {
-    char* m = status_.message;
-    const std::size_t cap = sizeof status_.message;
-    std::size_t n = 0;
-    auto put = [&](const char* s) {
-      for (; *s != '\0' && n + 1 < cap; ++s) m[n++] = *s;
-    };
-    put(e.field);
-    if (e.index >= 0) {
-      char digits[12];
-      int d = 0;
-      for (unsigned v = static_cast<unsigned>(e.index); d == 0 || v != 0; v /= 10) digits[d++] = static_cast<char>('0' + v % 10);
-      put("[");
-      while (d > 0 && n + 1 < cap) m[n++] = digits[--d];
-      put("]");
-    }
-    put(": ");
-    put(e.message);
-    m[n] = '\0';
-    return m;
-  }
-  void copy_message(const char* s) {
-    std::size_t i = 0;
-    for (; s[i] != '\0' && i + 1 < sizeof status_.message; ++i) status_.message[i] = s[i];
-    status_.message[i] = '\0';
-  }
+  void copy_message(const char* s) { copy_text(s, status_.message, sizeof status_.message); }
 
   Plant* plant_;
   Sink* sink_;
@@ -437,10 +377,7 @@ class Node {
   std::int64_t offset_ = 0;                             // bench clock - local clock (real time)
   std::uint64_t filled_ = 0;  // bit i: step next_k - 1 - i was filled (held or interpolated)
   double a_last_ = 0, a_prev_last_ = 0, aux_last_ = 0;
-  double ms_residual_ = 0;
-  double hist_[4] = {};
-  int hist_n_ = 0;
-  Ats ats_;
+  ModeOutputs outputs_;  // twin alarms, hybrid table command
   static constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 };
 
