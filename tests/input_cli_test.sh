@@ -93,6 +93,13 @@ expect 2 "--twin-kappa: a twin option: it needs --mode twin" -- "$VINES" hil dat
 echo "not an image" > "$WORK/bad.elf"
 expect 1 "--image $WORK/bad.elf: not a board image" -- "$VINES" hil data/scenes/elcentro_vines.toml --node qemu:cortex-m7 --image "$WORK/bad.elf"
 
+# A law whose board image was not built: the message says how to build it
+# (skipped where someone built it).
+if [ ! -e build/cortex-m7/firmware/app/vines_node_restitution.elf ]; then
+  expect 1 "-DVINES_NODE_LAWS=restitution && cmake --build --preset cortex-m7" -- \
+    "$VINES" hil data/scenes/elcentro_vines_restitution.toml --node qemu:cortex-m7
+fi
+
 # A file's bytes in a message are escaped and cut: an escape sequence does
 # not reach the terminal raw, a 1 MB token is not printed whole.
 printf '0 1\n0.01 \033[31mred\033[0m\n' > "$WORK/esc.txt"

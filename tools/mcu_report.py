@@ -81,10 +81,12 @@ Exit status 0 if every run succeeded, 1 if a run failed (the others are
 still reported) or on a user error (missing vines or image: says what to
 build). Interrupted (Ctrl-C), it waits for the runs under way and reports
 the finished ones (status 130). Needs: the presets cortex-m4f / cortex-m7 built (images
-build/TARGET/firmware/app/vines_node_{none,tmd,vines,twin}.elf), a host build of
+build/TARGET/firmware/app/vines_node_{none,tmd,kuwabara,twin}.elf), a host build of
 vines, qemu-system-arm, arm-none-eabi-size and -nm. Standard library only.
 """
 import argparse
+import contextlib
+import io
 import json
 import math
 import os
@@ -94,6 +96,7 @@ import tempfile
 
 # The package mcu/ beside this script, from any working folder.
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import figures  # noqa: E402
 from mcu import KINDS, ROOT, TARGETS, Failure  # noqa: E402
 from mcu.images import image_info  # noqa: E402
 from mcu.report import print_text, report  # noqa: E402
@@ -122,6 +125,9 @@ def main():
                                                             "(default: a temporary folder, removed)")
     ap.add_argument("-j", dest="jobs", type=int, default=1, help="benches (QEMU) at once, default 1")
     ap.add_argument("--json", action="store_true", help="one JSON object per target, one per line")
+    ap.add_argument("--figures", metavar="FILE.md", help="also write the text report there, stamped with the "
+                                                          "date, commit and machine (docs/figures/mcu.md); "
+                                                          "not if a run failed")
     a = ap.parse_args()
 
     a.targets = [t for t in a.targets.split(",") if t]
@@ -170,13 +176,24 @@ def main():
         complete = run_all(a.vines, jobs, a.jobs)
 
     failed = 0
+    texts = []
     for t in a.targets:
         rep = report(t, jobs, images, a)
         failed += sum(1 for r in rep["runs"] if "error" in r)
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            print_text(rep)
+        texts.append(text.getvalue())
         if a.json:
             print(json.dumps(rep), flush=True)
         else:
-            print_text(rep)
+            print(texts[-1], end="")
+    if a.figures and (failed or not complete):
+        print(f"mcu_report: {a.figures} not written: the figures of a failed or interrupted report are not kept",
+              file=sys.stderr)
+    elif a.figures:
+        figures.write(a.figures, "Boards: `tools/mcu_report.py`", "python3 tools/mcu_report.py " + " ".join(sys.argv[1:]),
+                      ["```text"] + "".join(texts).rstrip("\n").split("\n") + ["```"])
     if failed:
         print(f"mcu_report: {failed} run(s) failed or not run", file=sys.stderr)
     return 130 if not complete else 1 if failed else 0

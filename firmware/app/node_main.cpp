@@ -1,9 +1,10 @@
 // The board's firmware application: the link node (vines/link/node.hpp) over
 // the CMSDK UART, around one compiled instance of the core whose model the
 // host sends as an image (vines/link/model_plant.hpp). One image per device
-// (VINES_APP_DEVICE: 0 bare frame, 1 TMD, 2 VI NES with the Kuwabara law),
-// 10 stories, in the toolchain's scalar. The application loop is
-// firmware/app/node_app.hpp, the same source the host's `vines node` runs.
+// (VINES_APP_DEVICE: 0 bare frame, 1 TMD, 2 VI NES with the contact law
+// VINES_APP_LAW, a struct of the registry, contact_laws.hpp), 10 stories,
+// in the toolchain's scalar. The application loop is firmware/app/node_app.hpp,
+// the same source the host's `vines node` runs.
 // Exit status (semihosting): 0 after STOP, 1 if the link stays silent.
 #include "node_app.hpp"
 #include "vines/link/model_plant.hpp"
@@ -21,9 +22,9 @@ using Dev = vines::NoDevice;
 #elif VINES_APP_DEVICE == 1
 using Dev = vines::TmdDevice;
 #elif VINES_APP_DEVICE == 2
-using Dev = vines::VinesDevice<vines::ContactLaw::kKuwabara>;
+using Dev = vines::VinesDevice<vines::laws::VINES_APP_LAW::kTag>;
 #else
-#error "VINES_APP_DEVICE must be 0 (bare frame), 1 (tmd) or 2 (vines, Kuwabara)"
+#error "VINES_APP_DEVICE must be 0 (bare frame), 1 (tmd) or 2 (vines, with VINES_APP_LAW)"
 #endif
 
 using Plant = vines::link::ModelPlant<Scalar, kStories, Dev>;

@@ -1,13 +1,17 @@
 # Rules shared by every bare-metal image (the images here and the heap probe
 # in heap_probe/): startup code, the board's linker script (VINES_MCU_BOARD,
-# from the toolchain file: mps2-an386 or mps2-an500), and the heap ban.
+# the QEMU machine of the board's line in boards.txt, set by the toolchain
+# file: hal/mcu/<machine>.ld with - as _), and the heap ban.
 set(VINES_MCU_DIR ${CMAKE_CURRENT_LIST_DIR})
-if(NOT VINES_MCU_BOARD MATCHES "^mps2-an(386|500)$")
-  message(FATAL_ERROR "VINES_MCU_BOARD='${VINES_MCU_BOARD}': configure with a Cortex-M preset "
-    "(cmake --preset cortex-m4f or cortex-m7)")
+if(NOT VINES_MCU_BOARD)
+  message(FATAL_ERROR "VINES_MCU_BOARD is not set: configure with a board's preset (hal/mcu/boards.txt)")
 endif()
 string(REPLACE "-" "_" VINES_MCU_LINKER_SCRIPT ${VINES_MCU_BOARD})
 set(VINES_MCU_LINKER_SCRIPT ${VINES_MCU_DIR}/${VINES_MCU_LINKER_SCRIPT}.ld)
+if(NOT EXISTS ${VINES_MCU_LINKER_SCRIPT})
+  message(FATAL_ERROR "board machine '${VINES_MCU_BOARD}': no linker script ${VINES_MCU_LINKER_SCRIPT} "
+    "(a new QEMU machine needs one: hal/mcu/boards.txt)")
+endif()
 find_program(VINES_MCU_SIZE_TOOL arm-none-eabi-size REQUIRED)
 
 # Heap ban. Every allocator entry point of newlib and every C++ operator

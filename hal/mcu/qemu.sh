@@ -3,8 +3,8 @@
 # (semihosting SYS_EXIT_EXTENDED) is this script's. ctest uses it as
 # CMAKE_CROSSCOMPILING_EMULATOR (cmake/arm-none-eabi.cmake).
 #   qemu.sh BOARD IMAGE.elf [QEMU_OPTION...]
-# BOARD: mps2-an386 (Cortex-M4F), mps2-an500 (Cortex-M7) or mps2-an385
-# (Cortex-M3, no FPU: the fixed-point image). Extra options go
+# BOARD: a QEMU machine (hal/mcu/boards.txt's; mps2-an385, a Cortex-M3
+# without FPU, for the fixed-point image). Extra options go
 # to QEMU (e.g. -serial file:OUT, -icount shift=0); without a -serial option,
 # UART0 is not connected. Semihosting output goes to stderr. The run is
 # killed after VINES_QEMU_TIMEOUT seconds (default 600).
@@ -15,16 +15,16 @@ if (($# < 2)); then
 fi
 board=$1 image=$2
 shift 2
-case $board in
-  mps2-an385 | mps2-an386 | mps2-an500) ;;
-  *) echo "qemu.sh: unknown board '$board' (mps2-an385, mps2-an386 or mps2-an500)" >&2; exit 2 ;;
-esac
 if [[ ! -f $image ]]; then
   echo "qemu.sh: $image: no such image (build it first)" >&2
   exit 2
 fi
 if ! command -v qemu-system-arm >/dev/null; then
   echo "qemu.sh: qemu-system-arm not found: install it (bash tools/setup.sh)" >&2
+  exit 2
+fi
+if ! qemu-system-arm -machine help | awk '{print $1}' | grep -qxF -- "$board"; then
+  echo "qemu.sh: unknown board '$board': not a machine of qemu-system-arm (qemu-system-arm -machine help)" >&2
   exit 2
 fi
 serial=(-serial null)

@@ -25,7 +25,9 @@ def read_boards(path=BOARDS_FILE):
 
 TARGETS = read_boards()
 MARGIN = 1.5  # the step must fit in 2/3 of the period
-IMAGES = ("none", "tmd", "vines", "twin")  # vines_node_IMAGE.elf: a device's, or the twin estimator's
+IMAGES = ("none", "tmd", "kuwabara", "twin")  # vines_node_IMAGE.elf: a device's (a VI NES law's), or the twin's
+# A run's device -> its image: the VI NES scenes here keep the default law.
+IMAGE_OF = {"none": "none", "tmd": "tmd", "vines": "kuwabara"}
 KINDS = ("scene", "records", "ics", "tmd", "bare", "twin_vines", "twin_tmd", "twin_bare")
 # The twin node (docs/twin.md) on the twin image, for each device's building:
 # El Centro at 1 kHz, floors 3, 6, 8, 10 measured with 5 % noise;

@@ -3,7 +3,7 @@ TMD and bare-frame runs (worst and median step, sustained rate, flash, RAM,
 stack), the images and every run, as the JSON object of --json or as text."""
 import re
 
-from . import IMAGES, MARGIN, QUICK_DURATION_S, TARGETS, TWIN_KINDS
+from . import IMAGE_OF, IMAGES, MARGIN, QUICK_DURATION_S, TARGETS, TWIN_KINDS
 
 
 # The figures of one group of runs on one image (a mode's VI NES runs, or the TMD or
@@ -48,7 +48,7 @@ def report(target, jobs, images, a):
     for mode in (a.schemes or ["default"]):
         mine = [r for r in runs if r["device"] == "vines" and r["scheme"] == mode and r["kind"] not in TWIN_KINDS]
         if mine:
-            modes[mode] = figures(mine, images[(target, "vines")], clock, "scene")
+            modes[mode] = figures(mine, images[(target, IMAGE_OF["vines"])], clock, "scene")
     rep = {"target": target, "board": board, "scalar": scalar, "sensor_rate_hz": rate, "clock_hz": clock,
            "margin": MARGIN, "instructions_per_cycle_assumed": 1,
            "duration_cap_s": a.duration if a.duration else (QUICK_DURATION_S if a.quick else None),
@@ -58,7 +58,7 @@ def report(target, jobs, images, a):
     for kind, dev in (("tmd", "tmd"), ("bare", "none")) + tuple((k, "twin") for k in TWIN_KINDS):
         mine = [r for r in runs if r["kind"] == kind]
         if mine:
-            rep[kind] = figures(mine, images[(target, dev)], clock, kind)
+            rep[kind] = figures(mine, images[(target, IMAGE_OF.get(dev, dev))], clock, kind)
     keep = ("kind", "device", "image", "scheme", "record", "ic", "initial_position_m", "initial_velocity_mps",
             "duration_cap_s", "steps", "samples", "worst", "worst_k", "median", "overruns", "stack_peak_bytes",
             "max_deviation_from_offline", "outputs_finite", "wall_time_s", "tool_wall_time_s", "odd", "error")

@@ -10,7 +10,7 @@ import sys
 import threading
 import time
 
-from . import KINDS, PGA_G, QUICK_DURATION_S, ROOT, TARGETS, TWIN_ARGS, TWIN_KINDS, TWIN_RATE_HZ
+from . import IMAGE_OF, KINDS, PGA_G, QUICK_DURATION_S, ROOT, TARGETS, TWIN_ARGS, TWIN_KINDS, TWIN_RATE_HZ
 from .images import file_hash
 from .scenes import SCENE_IC, base_scene, ic_grid, records_list, vines_gap, write_scene
 
@@ -32,7 +32,7 @@ def plan(a, tmp, records_dir):
         job = {"target": target, "scheme": mode or "default", "kind": kind,
                "device": scene.get("device", {}).get("kind", "none"), "record": record, "ic": ic,
                "scene_file": path, "duration_cap_s": run_cap}
-        job["image"] = job["device"]
+        job["image"] = IMAGE_OF[job["device"]]
         job.update(extra or {})
         jobs.append(job)
 

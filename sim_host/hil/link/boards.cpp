@@ -40,10 +40,7 @@ std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) 
   if (opt.mode == HilMode::kTwin && opt.estimator == HilEstimator::kKalman) dev = "twin";
   else if (d.kind == DeviceKind::kNone) dev = "none";
   else if (d.kind == DeviceKind::kTmd) dev = "tmd";
-  else if (d.vines.law == ContactLaw::kKuwabara) dev = "vines";
-  else
-    throw std::runtime_error(sc.path + ": --node " + opt.node +
-                             ": the board images run the bare frame, the TMD and the VI NES with the Kuwabara law");
+  else dev = law_name(d.vines.law);  // vines_node_LAW.elf, one per law built (VINES_NODE_LAWS)
   if (dev == "twin" && sc.params.frame.stories > 10)
     throw std::runtime_error(sc.path + ": --node " + opt.node + ": the twin image holds up to 10 stories");
   if (dev != "twin" && sc.params.frame.stories != 10)
@@ -52,9 +49,12 @@ std::string board_image(const HilOptions& opt, const Board& b, const Scene& sc) 
                                               : std::string(VINES_SOURCE_DIR) + "/build/" + b.target +
                                                     "/firmware/app/vines_node_" + dev + ".elf";
   std::ifstream f(path, std::ios::binary);
-  if (!f)
+  if (!f) {
+    const bool law = d.kind == DeviceKind::kVines && dev != "twin";
     throw std::runtime_error("--node " + opt.node + ": no board image " + path + " (build it: cmake --preset " +
-                             b.target + " && cmake --build --preset " + b.target + ")");
+                             b.target + (law ? " -DVINES_NODE_LAWS=" + dev : "") + " && cmake --build --preset " +
+                             b.target + ")");
+  }
   // A 32-bit little-endian ARM ELF executable (e_machine 40), or QEMU would
   // fail on it with a register dump that names nothing.
   unsigned char h[20] = {};
