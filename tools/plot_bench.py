@@ -7,28 +7,20 @@ Usage: plot_bench.py BENCH.csv [--out FILE.png]
 Exit code 2, with a message naming the path, on a missing file or column.
 """
 import argparse
-import csv
-import sys
 from collections import defaultdict
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from figures import fail, read_csv  # noqa: E402
+
 COLUMNS = ["scene", "method", "scalar", "sensor_rate_hz", "contact_rtol", "wall_s_median", "peak_rel_error"]
 FLOOR = 1e-16  # errors below this are drawn at it (log scale)
 
 
 def load(path):
-    try:
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-    except OSError as e:
-        sys.exit(f"plot_bench.py: {path}: {e.strerror}")
-    for c in COLUMNS:
-        if rows and c not in rows[0]:
-            sys.exit(f"plot_bench.py: {path}: no column '{c}'")
-    return rows
+    return read_csv(path, COLUMNS, "plot_bench.py")
 
 
 def number(v):
@@ -45,7 +37,7 @@ def main():
     a = ap.parse_args()
     rows = load(a.csv)
     if not rows:
-        sys.exit(f"plot_bench.py: {a.csv}: no lines")
+        fail("plot_bench.py", f"{a.csv}: no lines")
     scenes = sorted({r["scene"].strip('"') for r in rows})
     cols = min(3, len(scenes))
     nrows = (len(scenes) + cols - 1) // cols

@@ -1,0 +1,67 @@
+#!/usr/bin/python3
+"""tools/figures.py and tools/plot_bench.py on small `vines bench --csv` files:
+the table's rows and stamp, and the refusals (exit 2 naming the file).
+
+Usage: figures_test.py REPO_ROOT
+"""
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = sys.argv[1]
+FIGURES = os.path.join(ROOT, "tools", "figures.py")
+PLOT = os.path.join(ROOT, "tools", "plot_bench.py")
+HEADER = "scene,method,contact_scheme,scalar,sensor_rate_hz,contact_rtol,wall_s_median,peak_rel_error,contacts\n"
+ROWS = ('"elcentro_vines",firmware,adaptive,double,1000,1e-08,0.0014812,3.21e-09,18\n'
+        '"elcentro_vines",dop853,adaptive,double,50,1e-08,0.0110,2.0e-07,18\n'
+        '"elcentro_tmd",firmware,adaptive,float,50,,0.000321,null,0\n')
+failures = []
+
+
+def run(*args):
+    return subprocess.run(["/usr/bin/python3", *args], capture_output=True, text=True)
+
+
+def check(what, ok):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    good = os.path.join(tmp, "bench.csv")
+    with open(good, "w") as f:
+        f.write(HEADER + ROWS)
+    out = os.path.join(tmp, "figures", "bench.md")
+    r = run(FIGURES, "bench", good, "--out", out, "--command", "bash tools/bench.sh --min-time 1")
+    check("bench table written (exit 0)", r.returncode == 0 and os.path.exists(out))
+    text = open(out).read() if os.path.exists(out) else ""
+    check("stamp names the command, a commit and the machine",
+          "Written by `bash tools/bench.sh --min-time 1` on " in text and ", commit " in text
+          and "cores" in text)
+    check("one section a scene, sorted", text.find("## elcentro_tmd") < text.find("## elcentro_vines") and
+          text.count("## ") == 2)
+    check("wall time in ms, error, contacts", "| firmware | adaptive | double | 1000 | 1e-08 | 1.48 | 3.2e-09 | 18 |" in text)
+    check("the baselines' rows have no contact scheme", "| dop853 | - | double | 50 |" in text)
+    check("a missing number is a dash", "| firmware | adaptive | float | 50 | - | 0.321 | - | 0 |" in text)
+    check("no temporary file left", sorted(os.listdir(os.path.dirname(out))) == ["bench.md"])
+
+    bad = os.path.join(tmp, "bad.csv")
+    with open(bad, "w") as f:
+        f.write("scene,method\nx,firmware\n")
+    empty = os.path.join(tmp, "empty.csv")
+    with open(empty, "w") as f:
+        f.write(HEADER)
+    missing = os.path.join(tmp, "missing.csv")
+    for tool, args in ((FIGURES, ["bench"]), (PLOT, [])):
+        name = os.path.basename(tool)
+        for path, says in ((bad, "no column 'contact_scheme'" if tool == FIGURES else "no column 'scalar'"),
+                           (empty, "no lines"), (missing, "No such file")):
+            r = run(tool, *args, path, "--out", os.path.join(tmp, "x.out"))
+            check(f"{name} {os.path.basename(path)}: exit 2 naming it ({says})",
+                  r.returncode == 2 and f"{name}: {path}: " in r.stderr and says in r.stderr)
+    check("nothing written on a refusal", not os.path.exists(os.path.join(tmp, "x.out")))
+
+print(f"figures_test: {len(failures)} failed")
+sys.exit(1 if failures else 0)

@@ -1,0 +1,156 @@
+#!/usr/bin/python3
+"""Measured figures as files: docs/figures/*.md, each written whole by the tool
+that measured it, stamped with the date, the commit and the machine, so that no
+figure in the guides is edited by hand (docs/figures/README.md).
+
+As a module (tools/mcu_report.py, tools/twin_benchmark.py): stamp() and write().
+As a command, the work-precision table of a `vines bench --csv` file:
+
+  figures.py bench BENCH.csv [--out docs/figures/bench.md] [--command CMD]
+
+Exit code 2, with a message naming the path, on a missing file or column.
+"""
+import argparse
+import csv
+import datetime
+import os
+import platform
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FIGURES = os.path.join(ROOT, "docs", "figures")
+
+
+def _git(*args):
+    try:
+        return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return ""
+
+
+def machine():
+    """'AMD EPYC 7B13, 2 cores, 24 GiB, Linux 6.1' from /proc (or platform)."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    mem = ""
+    try:
+        with open("/proc/meminfo") as f:
+            kb = int(f.readline().split()[1])
+        mem = f", {kb / 2**20:.0f} GiB"
+    except (OSError, ValueError, IndexError):
+        pass
+    return f"{cpu}, {os.cpu_count()} cores{mem}, {platform.system()} {platform.release()}"
+
+
+def stamp(command):
+    """The lines that say where the figures come from."""
+    commit = _git("rev-parse", "--short=12", "HEAD") or "unknown"
+    dirty = " with local changes" if _git("status", "--porcelain", "--untracked-files=no") else ""
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    return [f"Written by `{command}` on {now}, commit {commit}{dirty},",
+            f"on {machine()}. Do not edit: run the command again."]
+
+
+def fail(tool, message):
+    """The message on stderr, exit code 2."""
+    print(f"{tool}: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def table(header, rows):
+    """A markdown table."""
+    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return out
+
+
+def write(path, title, command, body):
+    """docs/figures/NAME.md: the title, the stamp, the body lines; whole or not
+    at all (a temporary file renamed over it)."""
+    text = "\n".join([f"# {title}", ""] + stamp(command) + [""] + list(body)) + "\n"
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    tmp = os.path.join(folder, f".{os.path.basename(path)}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except OSError as e:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        fail("figures.py", f"{path}: {e.strerror}")
+
+
+# ---- the work-precision table of `vines bench --csv` ----
+
+BENCH_COLUMNS = ["scene", "method", "contact_scheme", "scalar", "sensor_rate_hz", "contact_rtol", "wall_s_median",
+                 "peak_rel_error", "contacts"]
+
+
+def _g(v, fmt):
+    try:
+        x = float(v)
+    except ValueError:
+        return "-"
+    return "-" if x != x else format(x, fmt)
+
+
+def read_csv(path, columns, tool):
+    """The rows of a CSV file; exit 2 naming the tool and the path on a file
+    that cannot be read or lacks one of the columns (an empty file has none)."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        fail(tool, f"{path}: {e.strerror}")
+    for c in columns:
+        if rows and c not in rows[0]:
+            fail(tool, f"{path}: no column '{c}'")
+    return rows
+
+
+def bench_body(path):
+    rows = read_csv(path, BENCH_COLUMNS, "figures.py")
+    if not rows:
+        fail("figures.py", f"{path}: no lines")
+    body = []
+    for scene in sorted({r["scene"].strip('"') for r in rows}):
+        mine = [r for r in rows if r["scene"].strip('"') == scene]
+        body += [f"## {scene}", ""]
+        body += table(["method", "contact scheme", "scalar", "sensor rate Hz", "tolerance", "wall per run ms",
+                       "peak error", "contacts"],
+                      [[r["method"], r["contact_scheme"] if r["method"] == "firmware" else "-", r["scalar"], _g(r["sensor_rate_hz"], "g"), _g(r["contact_rtol"], "g"),
+                        _g(1e3 * float(r["wall_s_median"]), ".3g"), _g(r["peak_rel_error"], ".1e"), r["contacts"]]
+                       for r in mine])
+        body.append("")
+    return body
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    sub = ap.add_subparsers(dest="what", required=True)
+    b = sub.add_parser("bench", help="the work-precision table of a vines bench --csv file")
+    b.add_argument("csv")
+    b.add_argument("--out", default=os.path.join(FIGURES, "bench.md"))
+    b.add_argument("--command", default="bash tools/bench.sh", help="the command the stamp names")
+    a = ap.parse_args()
+    write(a.out, "Work-precision: `vines bench` on the El Centro scenes", a.command,
+          ["Wall time per full run (median of repeats, one core), peak top-floor displacement error",
+           "against `data/reference/`, contacts (the reference's in `vines reference`).", ""]
+          + bench_body(a.csv))
+    print(f"figures.py: wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()
