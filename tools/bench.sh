@@ -14,4 +14,4 @@ mkdir -p out/bench
 build/release/vines bench data/scenes/elcentro_*.toml --scalars double,float \
   --rates 50,200,1000,5000 --rtols 1e-6,1e-7,1e-8,1e-10,1e-12 --csv out/bench/bench.csv "$@"
 /usr/bin/python3 tools/plot_bench.py out/bench/bench.csv --out out/bench/work_precision.png
-/usr/bin/python3 tools/figures.py bench out/bench/bench.csv --command "bash tools/bench.sh $*"
+/usr/bin/python3 tools/figures.py bench out/bench/bench.csv --command "bash tools/bench.sh${*:+ $*}"

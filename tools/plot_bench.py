@@ -38,20 +38,26 @@ def main():
     rows = load(a.csv)
     if not rows:
         fail("plot_bench.py", f"{a.csv}: no lines")
-    scenes = sorted({r["scene"].strip('"') for r in rows})
+    # The points of each scene: (method, scalar, rate) -> [(wall, error)]; a line
+    # without a truth (null error: no reference for its scene) has none.
+    by_scene = defaultdict(lambda: defaultdict(list))
+    for r in rows:
+        scene = r["scene"].strip('"')
+        by_scene[scene]
+        err = number(r["peak_rel_error"])
+        if err == err:
+            key = (r["method"].strip('"'), r["scalar"].strip('"'), number(r["sensor_rate_hz"]))
+            by_scene[scene][key].append((number(r["wall_s_median"]), max(err, FLOOR)))
+    scenes = sorted(s for s in by_scene if by_scene[s])
+    for s in sorted(set(by_scene) - set(scenes)):
+        print(f"plot_bench.py: {s}: no line has a reference error (no data/reference file?): not drawn")
+    if not scenes:
+        fail("plot_bench.py", f"{a.csv}: no line has a reference error")
     cols = min(3, len(scenes))
     nrows = (len(scenes) + cols - 1) // cols
     fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.2 * nrows), squeeze=False)
     for ax, scene in zip(axes.flat, scenes):
-        series = defaultdict(list)
-        for r in rows:
-            if r["scene"].strip('"') != scene:
-                continue
-            err = number(r["peak_rel_error"])
-            if err != err:
-                continue
-            key = (r["method"].strip('"'), r["scalar"].strip('"'), number(r["sensor_rate_hz"]))
-            series[key].append((number(r["wall_s_median"]), max(err, FLOOR)))
+        series = by_scene[scene]
         for (method, scalar, rate), pts in sorted(series.items()):
             pts.sort()
             label = f"{method} {scalar}" + (f" {rate:g} Hz" if method == "firmware" else "")
