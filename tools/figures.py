@@ -72,10 +72,11 @@ def table(header, rows):
     return out
 
 
-def write(path, title, command, body):
-    """docs/figures/NAME.md: the title, the stamp, the body lines; whole or not
-    at all (a temporary file renamed over it)."""
-    text = "\n".join([f"# {title}", ""] + stamp(command) + [""] + list(body)) + "\n"
+def write(path, title, command, body, stamped=None):
+    """docs/figures/NAME.md: the title, the stamp (stamped: the lines stamp()
+    gave when the measurement began, or now), the body lines; whole or not at
+    all (a temporary file renamed over it)."""
+    text = "\n".join([f"# {title}", ""] + (stamped or stamp(command)) + [""] + list(body)) + "\n"
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     tmp = os.path.join(folder, f".{os.path.basename(path)}.{os.getpid()}.tmp")

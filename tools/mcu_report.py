@@ -129,6 +129,8 @@ def main():
                                                           "date, commit and machine (docs/figures/mcu.md); "
                                                           "not if a run failed")
     a = ap.parse_args()
+    command = "python3 tools/mcu_report.py " + " ".join(sys.argv[1:])
+    stamped = figures.stamp(command)  # the commit measured, not the one at the end
 
     a.targets = [t for t in a.targets.split(",") if t]
     for t in a.targets:
@@ -192,8 +194,8 @@ def main():
         print(f"mcu_report: {a.figures} not written: the figures of a failed or interrupted report are not kept",
               file=sys.stderr)
     elif a.figures:
-        figures.write(a.figures, "Boards: `tools/mcu_report.py`", "python3 tools/mcu_report.py " + " ".join(sys.argv[1:]),
-                      ["```text"] + "".join(texts).rstrip("\n").split("\n") + ["```"])
+        figures.write(a.figures, "Boards: `tools/mcu_report.py`", command,
+                      ["```text"] + "".join(texts).rstrip("\n").split("\n") + ["```"], stamped)
     if failed:
         print(f"mcu_report: {failed} run(s) failed or not run", file=sys.stderr)
     return 130 if not complete else 1 if failed else 0
