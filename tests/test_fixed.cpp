@@ -3,9 +3,13 @@
 // for the bare frame (top-floor displacement, every sample of the record).
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <random>
+#include <thread>
 
 #include "support.hpp"
 #include "vines/build_model.hpp"
+#include "vines/numeric/fixed_math.hpp"
 #include "vines/numeric/fixed_modal.hpp"
 
 namespace vines {
@@ -36,6 +40,84 @@ TEST(Fixed, EigenArraysTakeIt) {
   EXPECT_EQ(c(0), Q(2.5));
   EXPECT_EQ(c(1), Q(-4.5));
   EXPECT_EQ(c(2), Q(-1.0));
+}
+
+// isqrt64 against the defining inequalities r^2 <= v < (r + 1)^2, on the
+// edges (0, squares and their neighbours, 2^64 - 1) and on random values.
+TEST(FixedMath, IntegerSquareRootIsTheFloor) {
+  auto check = [](std::uint64_t v) {
+    std::uint64_t rem = 0;
+    const std::uint64_t r = numeric::isqrt64(v, &rem);
+    const unsigned __int128 r2 = static_cast<unsigned __int128>(r) * r;
+    const unsigned __int128 next = static_cast<unsigned __int128>(r + 1) * (r + 1);
+    EXPECT_TRUE(r2 <= v && v < next) << v;
+    EXPECT_EQ(rem, v - static_cast<std::uint64_t>(r2)) << v;
+  };
+  for (std::uint64_t v : {0ull, 1ull, 2ull, 3ull, 4ull, 15ull, 16ull, 17ull, ~0ull, ~0ull - 1})
+    check(v);
+  for (std::uint64_t r : {1ull, 3ull, 65535ull, 65536ull, 4294967295ull}) {
+    check(r * r);
+    check(r * r - 1);
+    check(r * r + 1);
+  }
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 100000; ++i) check(rng() >> (rng() % 64));
+}
+
+// Fixed sqrt is the real root rounded to nearest: within half an ulp of the
+// long double root, over the whole positive range of Q3.28.
+TEST(FixedMath, SquareRootRoundsToNearest) {
+  std::mt19937 rng(11);
+  fixed_saturations() = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const Q x = Q::from_raw(static_cast<std::int32_t>(rng() >> 1));
+    const long double exact = std::sqrt(static_cast<long double>(x.raw()) / Q::kOne) * Q::kOne;
+    const Q r = numeric::sqrt(x);
+    EXPECT_LE(std::fabs(static_cast<long double>(r.raw()) - exact), 0.5L) << x.raw();
+  }
+  EXPECT_EQ(numeric::sqrt(Q(0.0)), Q(0.0));
+  EXPECT_EQ(numeric::sqrt(Q(4.0)), Q(2.0));
+  EXPECT_EQ(fixed_saturations(), 0u);
+  EXPECT_EQ(numeric::sqrt(Q(-1.0)), Q(0.0));  // a domain error is a counted clamp
+  EXPECT_EQ(fixed_saturations(), 1u);
+}
+
+// A Wide sum of products equals the exactly rounded sum (products summed in
+// long double, exact here), and saturates visibly past its range.
+TEST(FixedMath, WideSumsProductsRoundedOnce) {
+  using W = numeric::Wide<40>;
+  std::mt19937 rng(3);
+  W w;
+  __int128 exact = 0;  // in 2^-56
+  for (int i = 0; i < 200000; ++i) {
+    const Q a = Q::from_raw(static_cast<std::int32_t>(rng())), b = Q::from_raw(static_cast<std::int32_t>(rng()));
+    w.add_product(a, b);
+    exact += static_cast<__int128>(a.raw()) * b.raw();
+  }
+  // Each product is rounded to 2^-40 once: the sum is within n/2 ulps.
+  const long double diff = static_cast<long double>(static_cast<__int128>(w.raw()) * 65536 - exact) / 65536.0L;
+  EXPECT_LE(std::fabs(diff), 200000 * 0.5L);
+  EXPECT_EQ(W::of(Q(1.5)).to_fixed<28>(), Q(1.5));
+  fixed_saturations() = 0;
+  W big = W::from_raw(std::numeric_limits<std::int64_t>::max() - 1);
+  big.add_product(Q(1.0), Q(1.0));
+  EXPECT_EQ(big.raw(), std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(W::of(Q(7.0)).add_product(Q(7.0), Q(7.0)).to_fixed<28>(), Q::max());  // 56 > 8
+  EXPECT_EQ(fixed_saturations(), 2u);
+}
+
+// Each host thread counts its own saturations (a study's runs share a pool).
+TEST(FixedMath, EachThreadCountsItsOwnSaturations) {
+  fixed_saturations() = 0;
+  std::uint32_t other = 99;
+  std::thread t([&] {
+    fixed_saturations() = 0;
+    for (int i = 0; i < 3; ++i) (void)(Q(7.0) + Q(7.0));
+    other = fixed_saturations();
+  });
+  t.join();
+  EXPECT_EQ(other, 3u);
+  EXPECT_EQ(fixed_saturations(), 0u);
 }
 
 // The bare frame of docs/model.md section 2 at 1 kHz: top-floor displacement from the double

@@ -7,6 +7,7 @@
 // Its range is +-2^(31-F) and its resolution 2^-F: quantities must be scaled
 // to O(1) first. fixed_modal.hpp does this for the modal exact step (the
 // linear frame propagation); see there for where it is and is not fit.
+// fixed_math.hpp has its square root and a 64-bit accumulator.
 #pragma once
 
 #include <cstdint>
@@ -16,12 +17,19 @@
 
 namespace vines::numeric {
 
-// How many operations saturated since the counter was last reset (single
-// core, no threads: a plain counter).
+// How many operations saturated since the counter was last reset. A board
+// has one core and no threads: a plain counter. On a host each thread counts
+// its own (the runs of a study share a pool of threads).
+#if defined(__arm__) && !defined(__linux__)
+#define VINES_FIXED_COUNTER static
+#else
+#define VINES_FIXED_COUNTER static thread_local
+#endif
 inline std::uint32_t& fixed_saturations() {
-  static std::uint32_t count = 0;
+  VINES_FIXED_COUNTER std::uint32_t count = 0;
   return count;
 }
+#undef VINES_FIXED_COUNTER
 
 template <int F>
 class Fixed {
