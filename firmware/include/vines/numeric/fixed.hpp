@@ -49,6 +49,8 @@ class Fixed {
     x.raw_ = r;
     return x;
   }
+  // From a wider raw value in the same format: saturated (and counted).
+  static Fixed saturated(std::int64_t r) { return from_raw(saturate(r)); }
 
   Raw raw() const { return raw_; }
   explicit operator double() const { return static_cast<double>(raw_) / kOne; }

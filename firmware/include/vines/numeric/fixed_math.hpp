@@ -93,9 +93,7 @@ class Wide {
     static_assert(F <= G, "to fewer fractional bits");
     Raw v = raw_;
     if constexpr (G > F) v = (v >> (G - F)) + ((v >> (G - F - 1)) & 1);
-    if (v > std::numeric_limits<std::int32_t>::max()) return (++fixed_saturations(), Fixed<F>::max());
-    if (v < std::numeric_limits<std::int32_t>::min()) return (++fixed_saturations(), Fixed<F>::lowest());
-    return Fixed<F>::from_raw(static_cast<std::int32_t>(v));
+    return Fixed<F>::saturated(v);
   }
 
  private:
