@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "vines/build_model.hpp"
 #include "vines/frame_presets.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"

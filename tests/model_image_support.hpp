@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "support.hpp"
+#include "vines/build_model.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
 

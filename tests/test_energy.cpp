@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "support.hpp"
+#include "vines/build_model.hpp"
 #include "vines/sim.hpp"
 
 namespace {

@@ -19,6 +19,7 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "support.hpp"
+#include "vines/build_model.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
 

@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "semihost.h"
+#include "vines/build_model.hpp"
 #include "vines/frame_presets.hpp"
 #include "vines/sim.hpp"
 

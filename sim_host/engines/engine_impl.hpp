@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim_host/engines/engine.hpp"
+#include "vines/build_model.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
 

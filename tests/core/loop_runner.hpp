@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vines/build_model.hpp"
 #include "vines/frame_presets.hpp"
 #include "vines/sim.hpp"
 

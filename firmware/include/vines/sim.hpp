@@ -21,7 +21,6 @@
 #include <cmath>
 #include <cstddef>
 
-#include "vines/build_model.hpp"
 #include "vines/data.hpp"
 #include "vines/exact_step.hpp"
 #include "vines/model.hpp"
