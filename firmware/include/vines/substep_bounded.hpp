@@ -240,10 +240,14 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   auto may_apply = [&] { return in_contact(st.mode) ? events < kBoundedEvents : events + 2 <= kBoundedEvents; };
   // The last slot must end the contact.
   auto slot_end_tol = [&] { return events + 1 == kBoundedEvents ? kInf : end_tol; };
-  auto apply = [&](int side) {
-    apply_event(m, d, st, y, side, slot_end_tol());
+  // After an event: its slot taken, the rate at the new state.
+  auto after_event = [&] {
     ++events;
     f = st(S(0), y);
+  };
+  auto apply = [&](int side) {
+    apply_event(m, d, st, y, side, slot_end_tol());
+    after_event();
   };
   // The rest of the step when no sub-step is left for it: free flight (a
   // contact that ended in the last sub-step) by one Euler step; in a contact
@@ -260,8 +264,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
   while (y(kT) < h) {
     // 1. An event due before any time passes (see due_event).
     if (may_apply() && detail::apply_due_event(m, d, st, y, slot_end_tol()) != 0) {
-      ++events;
-      f = st(S(0), y);
+      after_event();
       continue;
     }
     if (taken == budget) {  // only after an event in the last sub-step
