@@ -36,7 +36,7 @@ double pulse(double s, double s0, double tc) { return s > s0 && s < s0 + tc ? st
 // and velocity) after a step h with the pulse at [0.3 h, 0.7 h], from rest.
 double worst_relative_error(double h) {
   const M& m = frame_model();
-  const auto fm = fixed::force_moments<M::kP>(m.lti);
+  const auto fm = fixed::force_moments(m.lti);
   const double s0 = 0.3 * h, tc = 0.4 * h;
   constexpr int kSteps = 200000;
   const double ds = h / kSteps;

@@ -86,14 +86,12 @@ Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) 
   M2 a;
   a << 0.0, 1.0, -su.k / su.mf, -su.c / su.mf;
   const M2 phi = numeric::expm<M2>(a * kH);
-  Eigen::Vector2d akb[4];
+  Eigen::Vector2d akb[5];
   akb[0] << 0.0, 1.0 / su.mf;
-  for (int k = 1; k < 4; ++k) akb[k] = a * akb[k - 1];
+  for (int k = 1; k < 5; ++k) akb[k] = a * akb[k - 1];
   fixed::ContactCoupling<double> c;
   c.inv_m_star = 1.0 / su.m + 1.0 / su.mf;
-  c.inv_m_floor = 1.0 / su.mf;
-  c.k_floor = su.k / su.mf;
-  c.c_floor = su.c / su.mf;
+  for (int k = 1; k < 5; ++k) c.markov[k - 1] = akb[k](1);  // M_2 .. M_5
   c.h = kH;
   Eigen::Vector2d floor(x0, vf0);
   double s = x0, sv = vf0 + v0, q = 0.0, u = v0;
@@ -101,14 +99,14 @@ Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) 
   for (int step = 0; step < 50; ++step) {
     // g(t) = -x''(t) of the free floor: its derivatives at the step's start.
     double x[6] = {floor(0), floor(1)};
-    for (int k = 2; k < 6; ++k) x[k] = -(c.c_floor * x[k - 1] + c.k_floor * x[k - 2]);
+    for (int k = 2; k < 6; ++k) x[k] = -(su.c * x[k - 1] + su.k * x[k - 2]) / su.mf;
     for (int k = 0; k < 4; ++k) c.g[k] = -x[k + 2];
     fixed::ContactState<double> y0 = fixed::ContactState<double>::Zero();
     y0(0) = q;
     y0(1) = u;
-    const fixed::ForcedContact<double> r = fixed::forced_contact(su.law, c, y0, dw, 100000);
+    const fixed::ForcedContact<double> r = fixed::forced_contact(su.law, c, y0, dw, 0.0, 100000);
     EXPECT_TRUE(r.ended || r.y(2) >= kH * (1 - 1e-12)) << "step " << step;
-    const double mu[4] = {r.y(5), r.y(6), r.y(7), r.y(8)};
+    const double mu[4] = {r.y(3), r.y(4), r.y(5), r.y(6)};
     Eigen::Vector2d next = phi * floor;
     for (int k = 0; k < 4; ++k) next += akb[k] * mu[k];
     s += sv * kH - mu[1] / su.m;

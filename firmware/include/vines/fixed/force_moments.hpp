@@ -8,8 +8,8 @@
 // (omega_max h)^(K-1) in the positions (whose leading term is A bf mu_1):
 // measured 2.5e-7 for K = 4 at 1 kHz on the paper's frame, third order in h
 // (tests/core/test_force_moments.cpp). The contact integration
-// accumulates the mu_k; the coefficients A^k bf are built once, in double,
-// per mode (A's 2x2 block [0 1; ak ac], bf's velocity entry bfv).
+// accumulates the mu_k; the coefficients A^k bf come per mode from A's 2x2
+// block [0 1; ak ac] and bf's velocity entry bfv.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,16 +33,16 @@ struct ForceMoments {
   }
 };
 
-// A^k bf for each mode of l, k = 0..K-1, in double.
-template <int P, int K = 4>
-ForceMoments<double, P, K> force_moments(const ModalLti<double, P>& l) {
-  ForceMoments<double, P, K> out;
+// A^k bf for each mode of l, k = 0..K-1.
+template <int K = 4, typename S, int P>
+ForceMoments<S, P, K> force_moments(const ModalLti<S, P>& l) {
+  ForceMoments<S, P, K> out;
   for (int j = 0; j < P; ++j) {
-    double px = 0.0, pv = l.bfv(j);  // A^0 bf = [0; bfv]
+    S px = S(0), pv = l.bfv(j);  // A^0 bf = [0; bfv]
     for (int k = 0; k < K; ++k) {
       out.x[k](j) = px;
       out.v[k](j) = pv;
-      const double nx = pv, nv = l.ak(j) * px + l.ac(j) * pv;  // A [px; pv]
+      const S nx = pv, nv = l.ak(j) * px + l.ac(j) * pv;  // A [px; pv]
       px = nx;
       pv = nv;
     }

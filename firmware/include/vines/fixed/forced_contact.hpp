@@ -1,18 +1,19 @@
 // The overlap's equation in a contact on the frame, over one sensor step
-// (issue 34's split step, docs/fixed_point.md). A force F on the device floor
-// accelerates that floor by F / m_f at once (every mode kept: Phi Phi^T =
-// M^-1) and the ground acceleration cancels from the overlap d, so
-//   d'' = -F(d, d') / m* + g(t) + k_f y + c_f y',
-//   y'' = F / m_f - k_f y - c_f y',
-// with g(t) = g0 + g1 t + g2 t^2/2 + g3 t^3/6 the floor's free spring-and-
-// damper acceleration toward the wall over the step (a Taylor cubic from the
-// state at the step's start), y the floor's displacement by this step's
-// contact force, and k_f = K_ff / m_f, c_f = C_ff / m_f its own stiffness
-// and damping (the neighbours' share, of relative order (omega h)^2, is
-// left out). Integrated in w (dt/dw = 4 q^3, q = d^{1/4}) by classic
-// Runge-Kutta, with the force's moments about the step's end,
-// mu_k = int F(s) (h - s)^k / k! ds (k = 0..3), which move the frame
-// (fixed/force_moments.hpp) and the particle, and the energy lost.
+// (issue 34's split step, docs/fixed_point.md). The ground acceleration
+// cancels from the overlap d; the particle takes -F / m, and the device
+// floor its free motion plus its response to the force, which the frame's
+// Markov parameters M_n give (the floor's impulse response is
+// sum_n M_n tau^n / n!): with I_k(t) = int_0^t F(s) (t - s)^k / k! ds,
+//   d'' = g(t) - F / m - M_1 F - M_2 I_0 - ... - M_{K+1} I_{K-1},
+// g(t) = g0 + g1 t + g2 t^2/2 + g3 t^3/6 the free relative acceleration
+// toward the wall over the step (a Taylor cubic from the state at the
+// step's start). Integrated in w (dt/dw = 4 q^3, q = d^{1/4}) by classic
+// Runge-Kutta, with the energy lost and the force's moments about the
+// step's end, mu_k = int F(s) (h - s)^k / k! ds (k < K), which move the
+// frame (fixed/force_moments.hpp) and the particle, and from which the I_k
+// follow (floor_response). Each moment's rate is a quadrature of the force,
+// not a chain of integrals of one another: Runge-Kutta's error is then that
+// of the contact's own path.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,57 +23,97 @@
 
 namespace vines::fixed {
 
-template <typename S>
+// K: the moments carried (the frame's response to the force is then exact
+// to the power K - 1 of the step in the positions, K in the velocities,
+// fixed/force_moments.hpp).
+template <typename S, int K = 4>
 struct ContactCoupling {
-  S inv_m_star = S(0), inv_m_floor = S(0);  // 1 / m*, 1 / m_f
-  S k_floor = S(0), c_floor = S(0);         // K_ff / m_f, C_ff / m_f
-  S g[4] = {S(0), S(0), S(0), S(0)};        // g(t)'s Taylor coefficients
-  S h = S(0);                               // the step's end
+  S inv_m_star = S(0);  // 1 / m + M_1 (M_1 = 1 / m_f, the floor's mass)
+  S markov[K] = {};     // M_2 .. M_{K+1}
+  S g[4] = {};          // g(t)'s Taylor coefficients
+  S h = S(0);           // the step's end
 };
 
-// [q, u, t, y, y', mu_0..mu_3, e]: u = d', t from the step's start.
-template <typename S>
-using ContactState = Eigen::Matrix<S, 10, 1>;
+// [q, u, t, mu_0..mu_{K-1}, e]: u = d', t from the step's start.
+template <typename S, int K = 4>
+using ContactState = Eigen::Matrix<S, K + 4, 1>;
 
-template <typename S>
+template <typename S, int K = 4>
 struct ForcedContact {
-  ContactState<S> y;
-  bool ended = false;  // the contact ended (q back to 0) before the step's end
+  ContactState<S, K> y;
+  bool ended = false;   // the contact ended (q back to 0) before the step's end
+  bool capped = false;  // max_steps taken short of both ends
   int steps = 0;
+  S q_max = S(0);       // the largest q at the steps' ends (the contact's depth)
 };
 
 namespace detail {
 
-template <typename S, typename K>
-ContactState<S> contact_rate(const K& law, const ContactCoupling<S>& c, const ContactState<S>& y) {
+// The floor's response term sum_k M_{k+2} I_k(t), from the moments about
+// the step's end (I_k(t) = sum_{i <= k} mu_i (t - h)^{k-i} / (k-i)!),
+// gathered per moment: sum_i mu_i sum_{j < K - i} M_{i+j+2} x^j / j!,
+// x = t - h.
+template <typename S, int K>
+S floor_response(const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
+  const S x = y(2) - c.h;
+  S sum = S(0);
+  for (int i = 0; i < K; ++i) {
+    S poly = c.markov[K - 1];
+    for (int j = K - 1 - i; j > 0; --j) poly = c.markov[i + j - 1] + x * poly / S(j);
+    sum += poly * y(3 + i);
+  }
+  return sum;
+}
+
+template <typename S, int K, typename Law>
+ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
   const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q;
   const contact::Force<S> f = law.regular(q, u);
-  const S force = f.total(), r = c.h - t;
+  const S force = f.total();
   const S g = c.g[0] + t * (c.g[1] + t * (c.g[2] / S(2) + t * c.g[3] / S(6)));
-  const S spring = c.k_floor * y(3) + c.c_floor * y(4);
-  const S jf = j * force;
-  ContactState<S> d;
-  d << u, j * (g + spring - force * c.inv_m_star), j, j * y(4), j * (force * c.inv_m_floor - spring), jf, jf * r,
-      jf * r * r / S(2), jf * r * r * r / S(6), j * f.dissipative * u;
+  ContactState<S, K> d;
+  d(0) = u;
+  d(1) = j * (g - floor_response(c, y) - force * c.inv_m_star);
+  d(2) = j;
+  // mu_k' = F (h - t)^k / k!, each term from the last.
+  S term = j * force;
+  const S r = c.h - t;
+  for (int k = 0; k < K; ++k) {
+    d(3 + k) = term;
+    term = term * r / S(k + 1);
+  }
+  d(K + 3) = j * f.dissipative * u;
   return d;
 }
 
 }  // namespace detail
 
+// Near a contact's ends (q small against its scale q_ref) the path is
+// nearly q = q0 + u w and the force's terms are tiny: a step there may be
+// up to this many times dw (dw q_ref / (2 q)).
+inline constexpr int kMaxStretch = 4;
+
 // From y0 (q > 0, or q = 0 with u > 0 at first touch) to the contact's end
-// or the step's end, whichever comes first, `dw` in w a step, at most
-// max_steps; each end placed by Newton steps on a re-taken last step.
-template <typename S, typename K>
-ForcedContact<S> forced_contact(const K& law, const ContactCoupling<S>& c, const ContactState<S>& y0, S dw,
-                                int max_steps) {
-  auto rate = [&](const ContactState<S>& y) { return detail::contact_rate(law, c, y); };
-  ForcedContact<S> out;
+// or the step's end, whichever comes first, in steps of dw in w (stretched
+// near the contact's ends by q_ref, see kMaxStretch; q_ref = 0: none), at
+// most max_steps; each end placed by Newton steps on a re-taken last step.
+template <typename S, int K, typename Law>
+ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K>& c, const ContactState<S, K>& y0,
+                                   S dw, S q_ref, int max_steps) {
+  using State = ContactState<S, K>;
+  auto rate = [&](const State& y) { return detail::contact_rate(law, c, y); };
+  const S reach = q_ref / S(2), most = S(kMaxStretch) * dw;
+  ForcedContact<S, K> out;
   out.y = y0;
+  out.q_max = y0(0);
   for (; out.steps < max_steps; ++out.steps) {
-    const ContactState<S> next = numeric::rk4_step(rate, out.y, dw);
+    const S q = out.y(0);
+    const S step = q >= reach ? dw : (q * S(kMaxStretch) <= reach ? most : dw * reach / q);
+    const State next = numeric::rk4_step(rate, out.y, step);
     const bool ends = next(0) < S(0), late = next(2) > c.h;
     if (!ends && !late) {
       out.y = next;
+      if (next(0) > out.q_max) out.q_max = next(0);
       continue;
     }
     // Which comes first: the secant guesses of both, the earlier kept.
@@ -80,19 +121,22 @@ ForcedContact<S> forced_contact(const K& law, const ContactCoupling<S>& c, const
     S theta_h = late ? (c.h - out.y(2)) / (next(2) - out.y(2)) : S(2);
     const bool contact_ends = theta_end < theta_h;
     S theta = contact_ends ? theta_end : theta_h;
-    ContactState<S> y = numeric::rk4_step(rate, out.y, theta * dw);
+    State y = numeric::rk4_step(rate, out.y, theta * step);
     for (int it = 0; it < 3; ++it) {
-      const ContactState<S> d = rate(y);  // d/dw at the guess
+      const State d = rate(y);  // d/dw at the guess
       const S miss = contact_ends ? y(0) : y(2) - c.h, slope = contact_ends ? d(0) : d(2);
       if (slope == S(0)) break;
-      theta = theta - miss / (slope * dw);
-      y = numeric::rk4_step(rate, out.y, theta * dw);
+      theta = theta - miss / (slope * step);
+      theta = theta < S(0) ? S(0) : (theta > S(1) ? S(1) : theta);  // the end lies in this step
+      y = numeric::rk4_step(rate, out.y, theta * step);
     }
     out.y = y;
+    if (y(0) > out.q_max) out.q_max = y(0);
     out.ended = contact_ends;
     ++out.steps;
     return out;
   }
+  out.capped = true;
   return out;
 }
 
