@@ -284,7 +284,7 @@ TEST(BoundedScene, ValidateRefusesOutOfRangeValues) {
   p.loop.bounded_substeps = kMaxBoundedSubsteps + 1;
   EXPECT_STREQ(validate(p).field, "loop.bounded_substeps");
   p = bounded_scene();
-  p.loop.contact_scheme = static_cast<ContactScheme>(2);
+  p.loop.contact_scheme = static_cast<ContactScheme>(3);
   EXPECT_STREQ(validate(p).field, "loop.contact_scheme");
 }
 
@@ -298,15 +298,15 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   ASSERT_TRUE(link::decode(blob, n, &d));
   EXPECT_EQ(d.scene.loop.contact_scheme, ContactScheme::kBounded);
   EXPECT_EQ(d.scene.loop.bounded_substeps, 11);
-  // The scheme and budget bytes, before the deadline budget (u32), the
-  // hybrid compensator's kind (u8) and window (f64) and the twin's estimator
-  // (u8), the last fields.
+  // The scheme and budget bytes and the split scheme's steps (u16), before
+  // the deadline budget (u32), the hybrid compensator's kind (u8) and window
+  // (f64) and the twin's estimator (u8), the last fields.
   constexpr std::size_t kTail = 4 + 1 + 8 + 1;
-  const std::size_t at_scheme = n - kTail - 2, at_budget = n - kTail - 1;
+  const std::size_t at_scheme = n - kTail - 4, at_budget = n - kTail - 3;
   EXPECT_EQ(blob[at_scheme], 1);
   EXPECT_EQ(blob[at_budget], 11);
   for (const auto& [at, value] :
-       {std::pair<std::size_t, std::uint8_t>{at_scheme, 2}, {at_budget, 1}, {at_budget, 65}}) {
+       {std::pair<std::size_t, std::uint8_t>{at_scheme, 3}, {at_budget, 1}, {at_budget, 65}}) {
     std::uint8_t bad[link::kMaxConfigBlob];
     std::memcpy(bad, blob, n);
     bad[at] = value;
@@ -315,8 +315,8 @@ TEST(BoundedLink, ConfigCarriesTheSchemeAndRefusesBadValues) {
   // A blob of the previous layout (without the two bytes) is refused.
   std::uint8_t old[link::kMaxConfigBlob];
   std::memcpy(old, blob, at_scheme);
-  std::memcpy(old + at_scheme, blob + at_scheme + 2, kTail);
-  EXPECT_FALSE(link::decode(old, n - 2, &d));
+  std::memcpy(old + at_scheme, blob + at_scheme + 4, kTail);
+  EXPECT_FALSE(link::decode(old, n - 4, &d));
 }
 
 }  // namespace

@@ -62,7 +62,7 @@ RunStatus run_status(const RunTotals& t, const SceneParams& p, const ModelInfo& 
   if (k.divergences > 0)
     add("divergences_rolled_back", format("%lld steps rolled back (loop.divergence_limit_m = %g)",
                                           static_cast<long long>(k.divergences), loop.divergence_limit_m));
-  // The contact schemes' limits: the adaptive cap, the bounded budget.
+  // The contact schemes' limits: the adaptive cap, the bounded budget, the split cap.
   if (k.cap_hits > 0 && loop.contact_scheme == ContactScheme::kAdaptive)
     add("substep_cap_hits", format("%lld steps hit the sub-step cap (loop.max_substeps_per_step = %d): contacts "
                                    "in them are not resolved",
@@ -71,6 +71,11 @@ RunStatus run_status(const RunTotals& t, const SceneParams& p, const ModelInfo& 
     add("events_deferred", format("in %lld steps the sub-step budget (loop.bounded_substeps = %d) could not follow "
                                   "every event: they were deferred to the next step or stepped over",
                                   static_cast<long long>(k.cap_hits), loop.bounded_substeps));
+  if (k.cap_hits > 0 && loop.contact_scheme == ContactScheme::kSplit)
+    add("contact_steps_capped", format("in %lld steps a contact took all %d Runge-Kutta steps the step allows (%d "
+                                       "loop.split_steps) before the step's end: the rest of its force was left "
+                                       "to the next step",
+                                       static_cast<long long>(k.cap_hits), kSplitCap * loop.split_steps, kSplitCap));
   // The energy balance, when the ledger kept it.
   s.energy_checked = loop.energy_ledger;
   const double bound = scalar == Scalar::kFloat ? kResidualBoundFloat : kResidualBoundDouble;

@@ -53,12 +53,14 @@ std::optional<LimitError> check_contact_scales(const SceneParams& p) {
                                num(speed) + " m/s";
 
   // The smallest sub-step the loop may take in a sensor step of h.
+  // (The split scheme follows a contact in steps of its own scale: no
+  // sub-step of the sensor step bounds it.)
   const LoopParams& l = p.loop;
   const bool bounded = l.contact_scheme == ContactScheme::kBounded;
   const int most = bounded ? l.bounded_substeps : l.max_substeps_per_step;
   const std::string cap_key = bounded ? "loop.bounded_substeps" : "loop.max_substeps_per_step";
   const double substep = 1.0 / l.sensor_rate_hz / most;
-  if (t_c < kMinContactSubsteps * substep)
+  if (l.contact_scheme != ContactScheme::kSplit && t_c < kMinContactSubsteps * substep)
     return LimitError{size_key(p), "Hertz contact time under " + num(kMinContactSubsteps) + " smallest sub-steps",
                       "the Hertz contact lasts " + num(t_c) + " s (" + particle + "), under " +
                                        num(kMinContactSubsteps) + " of the smallest sub-steps, " + num(substep) +

@@ -28,8 +28,8 @@
 //   [loop]    sensor_rate_hz, contact_rtol, max_substeps_per_step,
 //             contact_count_depth_m, energy_ledger (default false),
 //             floor_peaks (default true), divergence_limit_m,
-//             contact_scheme = "adaptive" | "bounded", bounded_substeps,
-//             scalar = "double" | "float"
+//             contact_scheme = "adaptive" | "bounded" | "split", bounded_substeps,
+//             split_steps, scalar = "double" | "float"
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
 //
 // Rules:
@@ -216,9 +216,12 @@ void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
   s.read("floor_peaks", &l->floor_peaks);
   s.read("divergence_limit_m", &l->divergence_limit_m);
   s.choose<ContactScheme>("contact_scheme",
-                          {{"adaptive", ContactScheme::kAdaptive}, {"bounded", ContactScheme::kBounded}},
+                          {{"adaptive", ContactScheme::kAdaptive},
+                           {"bounded", ContactScheme::kBounded},
+                           {"split", ContactScheme::kSplit}},
                           &l->contact_scheme);
   s.read("bounded_substeps", &l->bounded_substeps);
+  s.read("split_steps", &l->split_steps);
   s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}}, scalar);
 }
 
@@ -279,7 +282,8 @@ const std::initializer_list<std::string_view> kRecordKeys = {"path",   "format",
                                                              "column", "scale",  "pga_g", "duration_s"};
 const std::initializer_list<std::string_view> kLoopKeys = {
     "sensor_rate_hz", "contact_rtol",   "max_substeps_per_step", "contact_count_depth_m", "energy_ledger",
-    "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "scalar"};
+    "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "split_steps",
+    "scalar"};
 const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries"};
 }  // namespace
 

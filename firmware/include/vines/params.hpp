@@ -107,11 +107,19 @@ struct DeviceParams {
 enum class ContactScheme : std::uint8_t {
   kAdaptive,  // adaptive Dormand-Prince sub-steps to contact_rtol, events to rounding
   kBounded,   // at most bounded_substeps sub-steps a step: worst-case work fixed by construction
+  kSplit,     // the overlap's scalar equation alone, the frame and the particle exact (substep_split.hpp)
 };
 
 // Range of loop.bounded_substeps (sub-steps a sensor step may take).
 inline constexpr int kMinBoundedSubsteps = 2;
 inline constexpr int kMaxBoundedSubsteps = 64;
+// Range of loop.split_steps (Runge-Kutta steps per unit of a contact's own
+// scale in w, substep_split.hpp).
+inline constexpr int kMinSplitSteps = 4;
+inline constexpr int kMaxSplitSteps = 1024;
+// Runge-Kutta steps a sensor step may take, in loop.split_steps: an impact
+// takes about 2 (and a step at 50 Hz may hold more than one).
+inline constexpr int kSplitCap = 16;
 
 struct LoopParams {
   double sensor_rate_hz = 1000.0;
@@ -131,9 +139,12 @@ struct LoopParams {
   // Contact integration: the adaptive scheme (contact_rtol,
   // max_substeps_per_step) or the bounded one, which takes at most
   // bounded_substeps Dormand-Prince sub-steps in a sensor step whatever
-  // happens in it (substep_bounded.hpp).
+  // happens in it (substep_bounded.hpp), or the split one, split_steps
+  // Runge-Kutta steps of the overlap's scalar equation per unit of the
+  // contact's own scale (substep_split.hpp).
   ContactScheme contact_scheme = ContactScheme::kAdaptive;
   int bounded_substeps = 6;
+  int split_steps = 64;
 };
 
 struct SceneParams {

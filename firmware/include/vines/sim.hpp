@@ -11,7 +11,9 @@
 //      if so: adaptive Dormand-Prince sub-steps through the step, contact
 //      starts and ends located to rounding, capped per step (cap hits are
 //      counted); or, with loop.contact_scheme = kBounded, at most
-//      loop.bounded_substeps aimed sub-steps (substep_bounded.hpp);
+//      loop.bounded_substeps aimed sub-steps (substep_bounded.hpp); or, with
+//      kSplit, the overlap's scalar equation alone, the frame and the
+//      particle moved exactly by its force's moments (substep_split.hpp);
 //   3. guards (non-finite input held, diverging steps rolled back), counters.
 // Work per step is bounded; no heap, no exceptions. run() feeds a block of
 // samples: the same steps, with runs of plain exact steps taken in blocks
@@ -29,6 +31,7 @@
 #include "vines/peaks.hpp"
 #include "vines/substep.hpp"
 #include "vines/substep_bounded.hpp"
+#include "vines/substep_split.hpp"
 
 namespace vines {
 
@@ -140,8 +143,13 @@ VINES_INLINE void careful_stage(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S
   if constexpr (Dev::kKind == DeviceKind::kVines) {
     close_elastic_run(m, d);
     const Data<S, N, Dev> before = d;
-    if (m.loop.contact_scheme == ContactScheme::kBounded) substep_bounded(m, d, a0, a1);
-    else substep_through(m, d, a0, a1);
+    if (m.loop.contact_scheme == ContactScheme::kBounded) {
+      substep_bounded(m, d, a0, a1);
+    } else if (m.loop.contact_scheme == ContactScheme::kSplit) {
+      if constexpr (!Dev::kImpulsive) substep_split(m, d, a0, a1);
+    } else {
+      substep_through(m, d, a0, a1);
+    }
     refresh_floors(m, d);
     if (diverged(m, d.z, d.xf, d.s, d.sd)) {
       const Counters count = d.count;

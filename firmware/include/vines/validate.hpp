@@ -105,10 +105,13 @@ inline ParamError validate(const LoopParams& l) {
     return {"loop.contact_count_depth_m", "must be >= 0"};
   if (!(std::isfinite(l.divergence_limit_m) && l.divergence_limit_m > 0.0))
     return {"loop.divergence_limit_m", "must be finite and > 0"};
-  if (l.contact_scheme != ContactScheme::kAdaptive && l.contact_scheme != ContactScheme::kBounded)
-    return {"loop.contact_scheme", "must be \"adaptive\" or \"bounded\""};
+  if (l.contact_scheme != ContactScheme::kAdaptive && l.contact_scheme != ContactScheme::kBounded &&
+      l.contact_scheme != ContactScheme::kSplit)
+    return {"loop.contact_scheme", "must be \"adaptive\", \"bounded\" or \"split\""};
   if (l.bounded_substeps < kMinBoundedSubsteps || l.bounded_substeps > kMaxBoundedSubsteps)
     return {"loop.bounded_substeps", "must be in [2, 64] (sub-steps per sensor step)"};
+  if (l.split_steps < kMinSplitSteps || l.split_steps > kMaxSplitSteps)
+    return {"loop.split_steps", "must be in [4, 1024] (Runge-Kutta steps per unit of a contact's scale)"};
   return {};
 }
 
@@ -117,6 +120,10 @@ inline ParamError validate(const SceneParams& s) {
   if (!e.ok()) return e;
   e = validate(s.device, s.frame.stories);
   if (!e.ok()) return e;
+  if (s.loop.contact_scheme == ContactScheme::kSplit && s.device.kind == DeviceKind::kVines &&
+      law_impulsive(s.device.vines.law))
+    return {"loop.contact_scheme", "\"split\" integrates a contact's force over time: it needs a law with a "
+                                   "finite contact duration (vines.law), not an instantaneous impact"};
   return validate(s.loop);
 }
 

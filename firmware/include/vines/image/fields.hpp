@@ -43,12 +43,15 @@ constexpr void visit_fields(V& v) {
   v(all, &M::loop, &LoopParams::divergence_limit_m);
   v(all, &M::loop, &LoopParams::contact_scheme);
   v(all, &M::loop, &LoopParams::bounded_substeps);
+  v(all, &M::loop, &LoopParams::split_steps);
   // New LoopParams fields here, one line each:
   //   v(all, &M::loop, &LoopParams::new_field);
   // Tripwire: a field added at the end of LoopParams without its line here
   // stops the build (then name the new last field below).
-  static_assert(sizeof(LoopParams) == offsetof(LoopParams, bounded_substeps) + sizeof(int),
-                "LoopParams has a field after bounded_substeps: add its line to visit_fields");
+  constexpr std::size_t kLoopEnd = offsetof(LoopParams, split_steps) + sizeof(int);
+  constexpr std::size_t kAlign = alignof(LoopParams);
+  static_assert(sizeof(LoopParams) == (kLoopEnd + kAlign - 1) / kAlign * kAlign,
+                "LoopParams has a field after split_steps: add its line to visit_fields");
 
   v(all, &M::h);
   v(all, &M::floor);

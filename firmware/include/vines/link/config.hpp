@@ -96,6 +96,7 @@ inline std::size_t encode(const NodeConfig& c, std::uint8_t* b, std::size_t cap)
   for (int i = 0; i < n; ++i) w.f64(c.drift_limit_m[i]);
   w.u8(static_cast<std::uint8_t>(l.contact_scheme));
   w.u8(static_cast<std::uint8_t>(l.bounded_substeps));
+  w.u16(static_cast<std::uint16_t>(l.split_steps));
   w.u32(c.budget_ticks);
   w.u8(static_cast<std::uint8_t>(c.comp_kind));
   w.f64(c.comp_window_s);
@@ -157,11 +158,13 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
   c->comp_order = r.u8();
   for (int i = 0; i < n; ++i) c->drift_limit_m[i] = r.f64();
   const std::uint8_t scheme = r.u8(), substeps = r.u8();
-  if (scheme > static_cast<std::uint8_t>(ContactScheme::kBounded) || substeps < kMinBoundedSubsteps ||
-      substeps > kMaxBoundedSubsteps)
+  const std::uint16_t split = r.u16();
+  if (scheme > static_cast<std::uint8_t>(ContactScheme::kSplit) || substeps < kMinBoundedSubsteps ||
+      substeps > kMaxBoundedSubsteps || split < kMinSplitSteps || split > kMaxSplitSteps)
     return false;
   l.contact_scheme = static_cast<ContactScheme>(scheme);
   l.bounded_substeps = substeps;
+  l.split_steps = split;
   c->budget_ticks = r.u32();
   c->comp_kind = static_cast<CompKind>(r.u8());
   c->comp_window_s = r.f64();

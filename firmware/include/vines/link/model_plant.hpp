@@ -146,6 +146,8 @@ class ModelPlant {
       return "loop.contact_scheme: differs from the model image's";
     if (c.scene.loop.bounded_substeps != model_->loop.bounded_substeps)
       return "loop.bounded_substeps: differs from the model image's";
+    if (c.scene.loop.split_steps != model_->loop.split_steps)
+      return "loop.split_steps: differs from the model image's";
     return nullptr;
   }
 
