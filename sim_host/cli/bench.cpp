@@ -99,14 +99,17 @@ void add_bench(CLI::App& vines) {
       ->delimiter(',')
       ->check(CLI::IsMember({"double", "float"}));
   cmd->add_option("--schemes", opt.schemes,
-                  "contact schemes: adaptive (a line per --rtols), bounded (a line per --substeps) (default: the "
-                  "scene's loop.contact_scheme)")
+                  "contact schemes: adaptive (a line per --rtols), bounded (a line per --substeps), split (a line "
+                  "per --split-steps) (default: the scene's loop.contact_scheme)")
       ->type_name("LIST")
       ->delimiter(',')
-      ->check(CLI::IsMember({"adaptive", "bounded"}));
+      ->check(CLI::IsMember({"adaptive", "bounded", "split"}));
   add_number_list(*cmd, "--substeps", &opt.bounded_substeps, kMinBoundedSubsteps, kMaxBoundedSubsteps,
                   "bounded scheme: sub-step budgets per sensor step, integers in [2, 64] (default: the scene's "
                   "loop.bounded_substeps)");
+  add_number_list(*cmd, "--split-steps", &opt.split_steps, kMinSplitSteps, kMaxSplitSteps,
+                  "split scheme: Runge-Kutta steps per unit of a contact's scale, integers in [4, 1024] (default: "
+                  "the scene's loop.split_steps)");
   a->baselines = add_number_list(*cmd, "--baselines", &opt.baseline_rtols,
                                  "baseline lines (see --baseline-methods) at these tolerances, fed the record's own "
                                  "points (default 1e-6,1e-8,1e-10; none with --json)");

@@ -55,16 +55,26 @@ void set_errors(const Truth& truth, BenchLine* l) {
   l->x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l->x_r - truth.x_r) : kNaN;
 }
 
-// One firmware line: the scene at one scalar, rate and tolerance, with the
-// adaptive contact scheme (substeps 0) or the bounded one with that budget.
-BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, int substeps, const Truth& truth,
-                        const BenchOptions& opt) {
+const char* scheme_name(ContactScheme s) {
+  switch (s) {
+    case ContactScheme::kBounded: return "bounded";
+    case ContactScheme::kSplit: return "split";
+    default: return "adaptive";
+  }
+}
+
+// One firmware line: the scene at one scalar, rate and tolerance, with a
+// contact scheme and its budget (bounded: loop.bounded_substeps, split:
+// loop.split_steps; adaptive: none).
+BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, ContactScheme cs, int budget,
+                        const Truth& truth, const BenchOptions& opt) {
   Scene scene = base;
   scene.scalar = scalar;
   scene.params.loop.sensor_rate_hz = rate;
   scene.params.loop.contact_rtol = rtol;
-  scene.params.loop.contact_scheme = substeps > 0 ? ContactScheme::kBounded : ContactScheme::kAdaptive;
-  if (substeps > 0) scene.params.loop.bounded_substeps = substeps;
+  scene.params.loop.contact_scheme = cs;
+  if (cs == ContactScheme::kBounded) scene.params.loop.bounded_substeps = budget;
+  if (cs == ContactScheme::kSplit) scene.params.loop.split_steps = budget;
   if (!opt.full_outputs) {
     scene.params.loop.floor_peaks = false;
     scene.params.loop.energy_ledger = false;
@@ -77,8 +87,8 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   l.scalar = scalar_name(scalar);
   l.rate_hz = rate;
   l.rtol = rtol;
-  l.scheme = substeps > 0 ? "bounded" : "adaptive";
-  l.bounded_substeps = substeps;
+  l.scheme = scheme_name(cs);
+  l.budget = cs == ContactScheme::kAdaptive ? 0 : budget;
   const auto b0 = std::chrono::steady_clock::now();
   std::unique_ptr<Engine> eng = build_engine(scene.params, scalar, scene.path);
   l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
@@ -189,21 +199,25 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   // the scene's tolerance, which sets the event tolerance).
   const LoopParams& loop = scene.params.loop;
   std::vector<std::string> schemes = opt.schemes;
-  if (schemes.empty()) schemes = {loop.contact_scheme == ContactScheme::kBounded ? "bounded" : "adaptive"};
+  if (schemes.empty()) schemes = {scheme_name(loop.contact_scheme)};
   const std::vector<int> budgets = opt.bounded_substeps.empty() ? std::vector<int>{loop.bounded_substeps}
                                                                  : opt.bounded_substeps;
+  const std::vector<int> splits = opt.split_steps.empty() ? std::vector<int>{loop.split_steps} : opt.split_steps;
   std::vector<BenchLine> lines;
   for (Scalar s : scalars)
     for (double rate : rates)
       for (const std::string& scheme : schemes) {
         if (scheme == "adaptive") {
-          for (double rtol : rtols) lines.push_back(firmware_line(scene, s, rate, rtol, 0, truth, opt));
-        } else if (scheme == "bounded") {
-          for (int k : budgets)
-            if (contacts || k == budgets.front())
-              lines.push_back(firmware_line(scene, s, rate, loop.contact_rtol, k, truth, opt));
+          for (double rtol : rtols)
+            lines.push_back(firmware_line(scene, s, rate, rtol, ContactScheme::kAdaptive, 0, truth, opt));
+        } else if (scheme == "bounded" || scheme == "split") {
+          const bool bounded = scheme == "bounded";
+          for (int k : bounded ? budgets : splits)
+            if (contacts || k == (bounded ? budgets : splits).front())
+              lines.push_back(firmware_line(scene, s, rate, loop.contact_rtol,
+                                            bounded ? ContactScheme::kBounded : ContactScheme::kSplit, k, truth, opt));
         } else {
-          throw std::runtime_error("--schemes: unknown contact scheme '" + scheme + "' (adaptive, bounded)");
+          throw std::runtime_error("--schemes: unknown contact scheme '" + scheme + "' (adaptive, bounded, split)");
         }
       }
   // Baselines in table order, whatever the order asked.
@@ -224,7 +238,8 @@ json line_json(const BenchLine& l) {
           {"sensor_rate_hz", l.rate_hz},
           {"contact_rtol", l.rtol},
           {"contact_scheme", l.scheme},
-          {"bounded_substeps", l.method == "firmware" && l.scheme == "bounded" ? json(l.bounded_substeps) : json(nullptr)},
+          {"bounded_substeps", l.method == "firmware" && l.scheme == "bounded" ? json(l.budget) : json(nullptr)},
+          {"split_steps", l.method == "firmware" && l.scheme == "split" ? json(l.budget) : json(nullptr)},
           {"max_substeps_in_a_step", l.max_substeps_in_step},
           {"runs", l.runs},
           {"wall_s_median", l.wall_median_s},
@@ -252,7 +267,7 @@ std::string format_table(const std::vector<BenchLine>& lines) {
   for (const BenchLine& l : lines) {
     char scheme[32] = "";
     if (l.method == "firmware")
-      std::snprintf(scheme, sizeof scheme, l.scheme == "bounded" ? "bounded/%d" : "adaptive", l.bounded_substeps);
+      std::snprintf(scheme, sizeof scheme, l.budget > 0 ? "%s/%d" : "%s", l.scheme.c_str(), l.budget);
     std::snprintf(buf, sizeof buf,
                   "%-26s %-12s %-10s %-6s %8.0f %7.3g %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
                   l.scene.c_str(), l.method.c_str(), scheme, l.scalar.c_str(), l.rate_hz, l.rtol,

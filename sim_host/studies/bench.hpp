@@ -30,10 +30,11 @@ struct Truth {
 // One line of the work-precision table.
 struct BenchLine {
   std::string scene, method, scalar;  // method: "firmware", "dop853", "cvode-adams", "cvode-bdf"
-  // Firmware lines: the contact scheme ("adaptive", "bounded") and, bounded,
-  // its sub-step budget; the most sub-steps any step took.
+  // Firmware lines: the contact scheme ("adaptive", "bounded", "split") and
+  // its budget (bounded: sub-steps a step, split: Runge-Kutta steps a
+  // contact scale, else 0); the most sub-steps any step took.
   std::string scheme = "adaptive";
-  int bounded_substeps = 0;
+  int budget = 0;
   long long max_substeps_in_step = 0;
   double rate_hz = 0, rtol = 0;
   int runs = 0;
@@ -50,9 +51,11 @@ struct BenchOptions {
   std::vector<double> rates_hz;      // empty: the scene's own
   std::vector<double> rtols;         // contact sub-step tolerances; empty: the scene's own
   // Contact schemes ("adaptive": a line per rtol; "bounded": a line per
-  // budget in bounded_substeps, empty: the scene's own); empty: the scene's.
+  // budget in bounded_substeps, "split": per split_steps; empty lists: the
+  // scene's own); empty: the scene's.
   std::vector<std::string> schemes;
   std::vector<int> bounded_substeps;
+  std::vector<int> split_steps;
   double min_time_s = 0.3;           // time each line for at least this long...
   int min_runs = 3;                  // ...and at least this many runs
   std::string reference_dir;         // "": data/reference of the source tree
