@@ -8,13 +8,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
 #include "sim_host/scene/scene.hpp"
+#include "reference_support.hpp"
 #include "support.hpp"
 #include "vines/link/config.hpp"
 #include "vines/substep_bounded.hpp"
@@ -26,12 +25,8 @@ using namespace vines;
 // The scene's default budget (what `contact_scheme = "bounded"` alone gets).
 const int kBudget = LoopParams{}.bounded_substeps;
 
-double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
-
-nlohmann::json reference(const std::string& name) {
-  std::ifstream in(std::string(VINES_SOURCE_DIR) + "/data/reference/" + name + ".json");
-  return nlohmann::json::parse(in);
-}
+using test::reference;
+using test::rel;
 
 SceneParams bounded_scene(ContactLaw law = ContactLaw::kKuwabara, double rate_hz = 1000.0, int budget = kBudget) {
   SceneParams p = test::paper_scene(DeviceKind::kVines, law, rate_hz);

@@ -16,6 +16,7 @@
 #include "sim_host/scene/frame.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "sim_host/studies/bench.hpp"
+#include "reference_support.hpp"
 #include "support.hpp"
 #include "vines/frame.hpp"
 
@@ -25,7 +26,7 @@ using namespace vines;
 using namespace vines::host;
 using namespace vines::host::reference;
 
-double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
+using test::rel;
 
 // ---- El Centro (slow) ----
 

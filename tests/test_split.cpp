@@ -9,13 +9,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
 #include "sim_host/scene/scene.hpp"
+#include "reference_support.hpp"
 #include "support.hpp"
 #include "vines/devices.hpp"
 #include "vines/link/config.hpp"
@@ -26,12 +25,8 @@ using namespace vines;
 
 const int kSteps = LoopParams{}.split_steps;
 
-double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
-
-nlohmann::json reference(const std::string& name) {
-  std::ifstream in(std::string(VINES_SOURCE_DIR) + "/data/reference/" + name + ".json");
-  return nlohmann::json::parse(in);
-}
+using test::reference;
+using test::rel;
 
 SceneParams split_scene(ContactLaw law = ContactLaw::kKuwabara, double rate_hz = 1000.0, int steps = kSteps) {
   SceneParams p = test::paper_scene(DeviceKind::kVines, law, rate_hz);
