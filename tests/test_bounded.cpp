@@ -14,6 +14,7 @@
 
 #include "sim_host/scene/scene.hpp"
 #include "reference_support.hpp"
+#include "scene_support.hpp"
 #include "support.hpp"
 #include "vines/link/config.hpp"
 #include "vines/substep_bounded.hpp"
@@ -228,28 +229,16 @@ TEST(Bounded, DefaultSchemeIsAdaptive) {
 
 // ---- scene keys and link fields ----
 
-const std::string kScene = R"(
-[device]
-kind = "vines"
-[record]
-path = "elcentro_1940_ns_2688pts_dt002_time_g.dat"
-[loop]
-)";
+// The scene tests' valid VI NES scene with these [loop] keys.
+std::string with_loop(const std::string& loop_keys) { return scene_test::kBase + "[loop]\n" + loop_keys; }
 
-std::string error_of(const std::string& loop_keys) {
-  try {
-    host::parse_scene(kScene + loop_keys, "bad.toml");
-  } catch (const host::SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::string& loop_keys) { return scene_test::error_of(with_loop(loop_keys)); }
 
 TEST(BoundedScene, KeysAreReadAndChecked) {
-  const host::Scene s = host::parse_scene(kScene + "contact_scheme = \"bounded\"\nbounded_substeps = 12\n", "ok.toml");
+  const host::Scene s = host::parse_scene(with_loop("contact_scheme = \"bounded\"\nbounded_substeps = 12\n"), "ok.toml");
   EXPECT_EQ(s.params.loop.contact_scheme, ContactScheme::kBounded);
   EXPECT_EQ(s.params.loop.bounded_substeps, 12);
-  EXPECT_EQ(host::parse_scene(kScene, "ok.toml").params.loop.contact_scheme, ContactScheme::kAdaptive);
+  EXPECT_EQ(host::parse_scene(with_loop(""), "ok.toml").params.loop.contact_scheme, ContactScheme::kAdaptive);
   struct Bad {
     const char* keys;
     const char* key;

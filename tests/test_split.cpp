@@ -15,6 +15,7 @@
 
 #include "sim_host/scene/scene.hpp"
 #include "reference_support.hpp"
+#include "scene_support.hpp"
 #include "support.hpp"
 #include "vines/devices.hpp"
 #include "vines/link/config.hpp"
@@ -209,35 +210,16 @@ TEST(Split, NoStepTakesMoreThanItsCap) {
 
 // ---- scene keys and link fields ----
 
-const std::string kScene = R"(
-[device]
-kind = "vines"
-[record]
-path = "elcentro_1940_ns_2688pts_dt002_time_g.dat"
-)";
-
-std::string error_of(const std::string& text) {
-  try {
-    host::parse_scene(kScene + text, "bad.toml");
-  } catch (const host::SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(SplitScene, KeysAreReadAndChecked) {
-  const host::Scene s = host::parse_scene(kScene + "[loop]\ncontact_scheme = \"split\"\nsplit_steps = 48\n", "ok.toml");
+  const host::Scene s =
+      host::parse_scene(scene_test::kBase + "[loop]\ncontact_scheme = \"split\"\nsplit_steps = 48\n", "ok.toml");
   EXPECT_EQ(s.params.loop.contact_scheme, ContactScheme::kSplit);
   EXPECT_EQ(s.params.loop.split_steps, 48);
-  for (const char* bad : {"[loop]\nsplit_steps = 3\n", "[loop]\nsplit_steps = 1025\n"}) {
-    const std::string msg = error_of(bad);
-    EXPECT_NE(msg.find("loop.split_steps"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("[4, 1024]"), std::string::npos) << msg;
-  }
+  for (const char* bad : {"[loop]\nsplit_steps = 3\n", "[loop]\nsplit_steps = 1025\n"})
+    scene_test::expect_refused(scene_test::kBase + bad, {"loop.split_steps", "[4, 1024]"});
   // An instantaneous impact has no contact to follow in time.
-  const std::string msg = error_of("[vines]\nlaw = \"restitution\"\n[loop]\ncontact_scheme = \"split\"\n");
-  EXPECT_NE(msg.find("loop.contact_scheme"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("finite contact duration"), std::string::npos) << msg;
+  scene_test::expect_refused(scene_test::kBase + "[vines]\nlaw = \"restitution\"\n[loop]\ncontact_scheme = \"split\"\n",
+                             {"loop.contact_scheme", "finite contact duration"});
 }
 
 TEST(SplitLink, ConfigCarriesTheSchemeAndItsSteps) {
