@@ -107,6 +107,36 @@ TEST(FixedMath, WideSumsProductsRoundedOnce) {
 }
 
 // Each host thread counts its own saturations (a study's runs share a pool).
+// power(x, a, b) = x^(a/b) through the integer base-2 logarithm and
+// exponential: relative error below 2^-9 (past the result's rounding, half
+// a unit of 2^-28) over Q3.28's range, the exponents
+// the split step's rule takes and others; 0 for x <= 0; saturation counted
+// past the range.
+TEST(FixedMath, PowerIsWithinItsBound) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> log_x(-20.0, 2.9);
+  const int exps[][2] = {{1, 10}, {1, 6}, {2, 3}, {1, 2}, {-2, 5}, {3, 2}, {1, 1}};
+  double worst = 0;
+  fixed_saturations() = 0;
+  for (const auto& ab : exps) {
+    for (int i = 0; i < 20000; ++i) {
+      const Q x(std::exp2(log_x(rng)));
+      const double want = std::pow(static_cast<double>(x), static_cast<double>(ab[0]) / ab[1]);
+      if (want >= 8.0 || want < 1e-6) continue;
+      const double got = static_cast<double>(numeric::power(x, ab[0], ab[1]));
+      worst = std::fmax(worst, (std::fabs(got - want) - 0.5 / Q::kOne) / want);
+    }
+  }
+  std::printf("power: largest relative error %.3g (2^-9 = %.3g)\n", worst, std::exp2(-9.0));
+  EXPECT_LT(worst, std::exp2(-9.0));
+  EXPECT_EQ(fixed_saturations(), 0u);
+  EXPECT_EQ(numeric::power(Q(0.0), 1, 10), Q(0.0));
+  EXPECT_EQ(numeric::power(Q(-1.0), 1, 2), Q(0.0));
+  EXPECT_EQ(numeric::power(Q(1.0), 1, 7), Q(1.0));
+  EXPECT_EQ(numeric::power(Q(4.0), 3, 1), Q::max());  // 64: past the range, counted
+  EXPECT_EQ(fixed_saturations(), 1u);
+}
+
 TEST(FixedMath, EachThreadCountsItsOwnSaturations) {
   fixed_saturations() = 0;
   std::uint32_t other = 99;

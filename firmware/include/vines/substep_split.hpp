@@ -32,6 +32,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -39,6 +40,7 @@
 #include "vines/data.hpp"
 #include "vines/events.hpp"
 #include "vines/exact_step.hpp"
+#include "vines/fixed/contact_step.hpp"
 #include "vines/fixed/force_moments.hpp"
 #include "vines/fixed/forced_contact.hpp"
 #include "vines/model.hpp"
@@ -91,27 +93,16 @@ fixed::ContactCoupling<S, K> split_coupling(const Model<S, N, Dev>& m,
 }
 
 // The Runge-Kutta step in w for a contact at q with overlap rate u under a
-// free relative acceleration toward the wall of at most g over the step, and
-// the contact's scale q_e. The contact's energy (1/2) m* u^2 + (2/5) c q^10
-// (the Hertz part) reaches q^10 = q^10 + (5/4) (m*/c) u^2 at rest; g pressing
-// from rest reaches q^6 = (5/2) m* g / c; q_e is the larger, and with the
-// speed of an impact that deep, v_e = sqrt(0.8 c / m*) q_e^5,
-// dw = q_e / (n v_e) = 1 / (n sqrt(0.8 c / m*) q_e^4): the contact's own
-// oscillation then turns about 5.5 / n radians a step. A contact with
-// neither gets the scale of a thousandth of the model's typical one.
-template <typename S>
-struct SplitScale {
-  S dw, q_e;
-};
-
+// free relative acceleration toward the wall of at most g
+// (fixed/contact_step.hpp): about 2 loop.split_steps steps an impact,
+// whatever its speed. A contact with neither energy nor pressing gets the
+// scale of a thousandth of the model's typical one.
 template <typename S, int N, typename Dev>
-SplitScale<S> split_scale(const Model<S, N, Dev>& m, S q, S u, S g) {
+fixed::ContactStep<S> split_scale(const Model<S, N, Dev>& m, S q, S u, S g) {
   const auto& dm = m.dev;
-  const S q2 = q * q, q10 = q2 * q2 * q2 * q2 * q2;
-  const S by_energy = std::pow(q10 + S(1.25) * dm.m_star / dm.c * u * u, S(0.1));
-  const S by_force = std::pow(S(2.5) * dm.m_star / dm.c * std::fabs(g), S(1) / S(6));
-  const S q_e = numeric::max_of(numeric::max_of(by_energy, by_force), S(1e-3) * dm.q_scale), q_e2 = q_e * q_e;
-  return {S(1) / (static_cast<S>(m.loop.split_steps) * std::sqrt(S(0.8) * dm.c / dm.m_star) * q_e2 * q_e2), q_e};
+  const S dw_unit = S(1) / (static_cast<S>(m.loop.split_steps) * std::sqrt(S(0.8) * dm.c / dm.m_star));
+  return fixed::contact_step(q, u, std::fabs(g), dm.m_star / dm.c, S(1e-3) * dm.q_scale, dw_unit,
+                             std::numeric_limits<S>::infinity());
 }
 
 // Where a free step (relative position r, rate rd at both ends) first
@@ -237,7 +228,7 @@ void substep_split(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
   // The largest free relative acceleration over the step, a bound from g(t)'s terms.
   const S g_max =
       std::fabs(c.g[0]) + h * (std::fabs(c.g[1]) + h * (std::fabs(c.g[2]) / S(2) + h * std::fabs(c.g[3]) / S(6)));
-  const detail::SplitScale<S> scale = detail::split_scale(m, start.q, start.u, g_max);
+  const fixed::ContactStep<S> scale = detail::split_scale(m, start.q, start.u, g_max);
   const fixed::ForcedContact<S, K> fc =
       fixed::forced_contact(dm.law, c, y0, scale.dw, scale.q_e, cap);
   S mu[K];

@@ -14,6 +14,13 @@
 // follow (floor_response). Each moment's rate is a quadrature of the force,
 // not a chain of integrals of one another: Runge-Kutta's error is then that
 // of the contact's own path.
+//
+// Units: any consistent set (SI in the double and float loops). In fixed
+// point the contact's own (fixed/contact.hpp: overlap D, speed V, time
+// T = D / V, force m V^2 / D), with the moments' lever arm (h - s) in a unit
+// tau of its own (the sensor step, so that it stays within [0, 1] at every
+// rate): r_scale = T / tau, mu_k in m V tau^k, M_{k+2} in 1 / (m T tau^k)
+// (fixed/contact_coupling.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -32,6 +39,7 @@ struct ContactCoupling {
   S markov[K] = {};     // M_2 .. M_{K+1}
   S g[4] = {};          // g(t)'s Taylor coefficients
   S h = S(0);           // the step's end
+  S r_scale = S(1);     // the moments' lever arm (h - t) in its own unit: (h - t) r_scale
 };
 
 // [q, u, t, mu_0..mu_{K-1}, e]: u = d', t from the step's start.
@@ -52,10 +60,10 @@ namespace detail {
 // The floor's response term sum_k M_{k+2} I_k(t), from the moments about
 // the step's end (I_k(t) = sum_{i <= k} mu_i (t - h)^{k-i} / (k-i)!),
 // gathered per moment: sum_i mu_i sum_{j < K - i} M_{i+j+2} x^j / j!,
-// x = t - h.
+// x = (t - h) r_scale.
 template <typename S, int K>
 S floor_response(const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
-  const S x = y(2) - c.h;
+  const S x = (y(2) - c.h) * c.r_scale;
   S sum = S(0);
   for (int i = 0; i < K; ++i) {
     S poly = c.markov[K - 1];
@@ -77,7 +85,7 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K>& c, 
   d(2) = j;
   // mu_k' = F (h - t)^k / k!, each term from the last.
   S term = j * force;
-  const S r = c.h - t;
+  const S r = (c.h - t) * c.r_scale;
   for (int k = 0; k < K; ++k) {
     d(3 + k) = term;
     term = term * r / S(k + 1);

@@ -9,6 +9,9 @@
 //   Wide<G>         a signed 64-bit accumulator with G fractional bits that
 //                   takes products of two Fixed<F> rounded once (F <= G <= 2F),
 //                   saturating and counting like Fixed
+//   power(x, a, b)  x^(a/b) for x > 0 through a base-2 logarithm and
+//                   exponential with kLogBits fractional bits (relative error
+//                   below 2^-9): the split contact step's step-size rule
 #pragma once
 
 #include <cstdint>
@@ -48,6 +51,68 @@ Fixed<F> sqrt(Fixed<F> x) {
   std::uint64_t rem = 0;
   const std::uint64_t r = isqrt64(static_cast<std::uint64_t>(x.raw()) << F, &rem);
   return Fixed<F>::from_raw(static_cast<std::int32_t>(rem > r ? r + 1 : r));
+}
+
+// Fractional bits of the base-2 logarithm power() goes through.
+inline constexpr int kLogBits = 12;
+
+// floor(2^kLogBits log2(raw 2^-F)) of a positive raw value: the integer
+// part from the leading bit, each fractional bit by squaring the mantissa
+// (in [1, 2), Q1.30) once.
+template <int F>
+constexpr std::int32_t log2_raw(std::uint32_t raw) {
+  int lead = 31;
+  while (!(raw >> lead)) --lead;
+  std::int32_t out = (lead - F) * (std::int32_t{1} << kLogBits);
+  std::uint64_t m = lead >= 30 ? raw >> (lead - 30) : std::uint64_t{raw} << (30 - lead);
+  for (int bit = kLogBits - 1; bit >= 0; --bit) {
+    m = (m * m) >> 30;
+    if (m >> 31) {
+      m >>= 1;
+      out += std::int32_t{1} << bit;
+    }
+  }
+  return out;
+}
+
+// 2^(2^-(kLogBits - i)) in Q1.30, i < kLogBits: square roots of 2, taken
+// one after another in integers (floors), so the table is the same on every
+// compiler.
+struct Exp2Table {
+  std::uint32_t v[kLogBits] = {};
+  constexpr Exp2Table() {
+    std::uint64_t r = isqrt64(std::uint64_t{2} << 60);  // 2^(1/2) in Q1.30
+    for (int i = kLogBits - 1; i >= 0; --i) {
+      v[i] = static_cast<std::uint32_t>(r);
+      r = isqrt64(r << 30);
+    }
+  }
+};
+
+// 2^(e 2^-kLogBits) in Q(31-F).F: the fractional part as a product of the
+// table's factors (each rounded), shifted by the integer part; saturated
+// (and counted) past the range, 0 below its resolution.
+template <int F>
+Fixed<F> exp2_raw(std::int32_t e) {
+  static constexpr Exp2Table kTable{};
+  const std::int32_t whole = e >> kLogBits;  // floor
+  std::uint64_t v = std::uint64_t{1} << 30;
+  for (int i = 0; i < kLogBits; ++i)
+    if ((e >> i) & 1) v = (v * kTable.v[i] + (std::uint64_t{1} << 29)) >> 30;
+  const int shift = whole + F - 30;
+  if (shift >= 0) return Fixed<F>::saturated(shift > 32 ? std::int64_t{1} << 62 : static_cast<std::int64_t>(v << shift));
+  if (shift < -40) return Fixed<F>(0);
+  return Fixed<F>::from_raw(static_cast<std::int32_t>((v + (std::uint64_t{1} << (-shift - 1))) >> -shift));
+}
+
+// x^(a/b) for x > 0 (b > 0); 0 for x <= 0. Bounded work: kLogBits squarings
+// and at most kLogBits products.
+template <int F>
+Fixed<F> power(Fixed<F> x, int a, int b) {
+  if (x.raw() <= 0) return Fixed<F>(0);
+  const std::int64_t l = std::int64_t{log2_raw<F>(static_cast<std::uint32_t>(x.raw()))} * a;
+  const std::int64_t e = l >= 0 ? l / b : -((-l + b - 1) / b);  // floor
+  return exp2_raw<F>(static_cast<std::int32_t>(e));
 }
 
 template <int G>
