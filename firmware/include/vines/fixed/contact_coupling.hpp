@@ -25,18 +25,18 @@ struct CouplingUnits {
   double tau = 0;  // the moments' time unit [s]
 };
 
-// The coupling c (SI) in the units cu, in the scalar S.
-template <typename S, int K>
-ContactCoupling<S, K> scaled_coupling(const ContactCoupling<double, K>& c, const CouplingUnits& cu) {
+// The coupling c (SI) in the units cu, in the scalar S (r_scale in R).
+template <typename S, typename R = S, int K>
+ContactCoupling<S, K, R> scaled_coupling(const ContactCoupling<double, K>& c, const CouplingUnits& cu) {
   const ContactUnits& u = cu.u;
-  ContactCoupling<S, K> out;
+  ContactCoupling<S, K, R> out;
   out.inv_m_star = S(c.inv_m_star * u.m);
   double arm = 1.0;  // tau^k
   for (int k = 0; k < K; ++k, arm *= cu.tau) out.markov[k] = S(c.markov[k] * u.m * u.t * arm);
   double tk = u.t;  // T^{k+1}
   for (int k = 0; k < 4; ++k, tk *= u.t) out.g[k] = S(c.g[k] * tk / u.v);
   out.h = S(c.h / u.t);
-  out.r_scale = S(u.t / cu.tau);
+  out.r_scale = R(u.t / cu.tau);
   return out;
 }
 

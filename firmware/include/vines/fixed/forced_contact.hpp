@@ -33,13 +33,15 @@ namespace vines::fixed {
 // K: the moments carried (the frame's response to the force is then exact
 // to the power K - 1 of the step in the positions, K in the velocities,
 // fixed/force_moments.hpp).
-template <typename S, int K = 4>
+// R: the type of r_scale (S; in fixed point a numeric::Gain, since T / tau
+// may pass the format's range).
+template <typename S, int K = 4, typename R = S>
 struct ContactCoupling {
   S inv_m_star = S(0);  // 1 / m + M_1 (M_1 = 1 / m_f, the floor's mass)
   S markov[K] = {};     // M_2 .. M_{K+1}
   S g[4] = {};          // g(t)'s Taylor coefficients
   S h = S(0);           // the step's end
-  S r_scale = S(1);     // the moments' lever arm (h - t) in its own unit: (h - t) r_scale
+  R r_scale = R(1);     // the moments' lever arm (h - t) in its own unit: (h - t) r_scale
 };
 
 // [q, u, t, mu_0..mu_{K-1}, e]: u = d', t from the step's start.
@@ -61,8 +63,8 @@ namespace detail {
 // the step's end (I_k(t) = sum_{i <= k} mu_i (t - h)^{k-i} / (k-i)!),
 // gathered per moment: sum_i mu_i sum_{j < K - i} M_{i+j+2} x^j / j!,
 // x = (t - h) r_scale.
-template <typename S, int K>
-S floor_response(const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
+template <typename S, int K, typename R>
+S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y) {
   const S x = (y(2) - c.h) * c.r_scale;
   S sum = S(0);
   for (int i = 0; i < K; ++i) {
@@ -73,8 +75,8 @@ S floor_response(const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
   return sum;
 }
 
-template <typename S, int K, typename Law>
-ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K>& c, const ContactState<S, K>& y) {
+template <typename S, int K, typename R, typename Law>
+ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y) {
   const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q;
   const contact::Force<S> f = law.regular(q, u);
   const S force = f.total();
@@ -105,8 +107,8 @@ inline constexpr int kMaxStretch = 4;
 // or the step's end, whichever comes first, in steps of dw in w (stretched
 // near the contact's ends by q_ref, see kMaxStretch; q_ref = 0: none), at
 // most max_steps; each end placed by Newton steps on a re-taken last step.
-template <typename S, int K, typename Law>
-ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K>& c, const ContactState<S, K>& y0,
+template <typename S, int K, typename R, typename Law>
+ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y0,
                                    S dw, S q_ref, int max_steps) {
   using State = ContactState<S, K>;
   auto rate = [&](const State& y) { return detail::contact_rate(law, c, y); };

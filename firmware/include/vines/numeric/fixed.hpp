@@ -110,6 +110,10 @@ template <int F>
 Fixed<F> abs(Fixed<F> x) {
   return x < Fixed<F>(0) ? -x : x;
 }
+template <int F>
+Fixed<F> fabs(Fixed<F> x) {
+  return abs(x);
+}
 
 }  // namespace vines::numeric
 

@@ -26,28 +26,38 @@ struct Cubic {
   }
   // Largest value on [0, 1] (ends and interior stationary points).
   S max_value() const {
+    using std::fabs;  // and numeric's own for the fixed-point scalar
+    using std::sqrt;
     S best = y0 > y1 ? y0 : y1;
     // slope = A th^2 + B th + C
     const S a = S(6) * y0 + S(3) * d0 - S(6) * y1 + S(3) * d1;
     const S b = S(-6) * y0 - S(4) * d0 + S(6) * y1 - S(2) * d1;
     const S c = d0;
+    // Roots inside (0, 1) only, each found without dividing outside it (a
+    // fixed-point quotient out of range would saturate for nothing).
     S roots[2];
     int n = 0;
-    if (std::fabs(a) > S(1e-30) * (std::fabs(b) + std::fabs(c))) {
+    auto inside = [&](S num, S den) {
+      if (den < S(0)) {
+        num = -num;
+        den = -den;
+      }
+      if (num > S(0) && num < den) roots[n++] = num / den;
+    };
+    if (fabs(a) > S(1e-30) * (fabs(b) + fabs(c))) {
       const S disc = b * b - S(4) * a * c;
       if (disc >= S(0)) {
-        const S sq = std::sqrt(disc);
-        roots[n++] = (-b + sq) / (S(2) * a);
-        roots[n++] = (-b - sq) / (S(2) * a);
+        const S sq = sqrt(disc);
+        inside(-b + sq, S(2) * a);
+        inside(-b - sq, S(2) * a);
       }
-    } else if (std::fabs(b) > S(0)) {
-      roots[n++] = -c / b;
+    } else if (fabs(b) > S(0)) {
+      inside(-c, b);
     }
-    for (int i = 0; i < n; ++i)
-      if (roots[i] > S(0) && roots[i] < S(1)) {
-        const S v = value(roots[i]);
-        if (v > best) best = v;
-      }
+    for (int i = 0; i < n; ++i) {
+      const S v = value(roots[i]);
+      if (v > best) best = v;
+    }
     return best;
   }
   // First theta in (0, 1] where the cubic rises through zero, given
@@ -64,7 +74,7 @@ bool grid_upcrossing(const Curve& c, S f0, S* lo, S* hi) {
   constexpr int kGrid = 16;
   S a = S(0), fa = f0;
   for (int i = 1; i <= kGrid; ++i) {
-    const S b = S(i) / S(kGrid), fb = c.value(b);
+    const S b = a + S(1.0 / kGrid), fb = c.value(b);  // i / kGrid exactly (no S(16): past Q3.28)
     if (fb > S(0) && fa <= S(0)) {
       *lo = a;
       *hi = b;
@@ -114,12 +124,12 @@ S quintic_abs_max(S y0, S v0, S a0, S y1, S v1, S a1, S h) {
   S best = std::fabs(y0) > std::fabs(y1) ? std::fabs(y0) : std::fabs(y1);
   // Stationary points: sign changes of p' on a grid, then Newton.
   constexpr int kGrid = 8;
-  S prev = dp(S(0));
-  for (int i = 1; i <= kGrid; ++i) {
-    const S t1 = S(i) / S(kGrid), cur = dp(t1);
+  S prev = dp(S(0)), t0 = S(0);
+  for (int i = 1; i <= kGrid; ++i, t0 += S(1.0 / kGrid)) {
+    const S t1 = t0 + S(1.0 / kGrid), cur = dp(t1);
     if ((prev < S(0)) != (cur < S(0))) {
       // Bisection on the sign of p' (50 halvings: below any scalar's resolution).
-      S a = S(i - 1) / S(kGrid), b = t1;
+      S a = t0, b = t1;
       const bool rising_at_a = prev > S(0);
       for (int it = 0; it < 50; ++it) {
         const S m = S(0.5) * (a + b);

@@ -1,0 +1,73 @@
+// A constant factor of any magnitude for the fixed-point scalar (fixed.hpp):
+// a mantissa in Q1.30 (|m| in [1/2, 1), or 0) and a power of two, like a
+// float whose exponent is fixed when the model is built. x * g is one 64-bit
+// product and one shift, rounded to nearest and saturated (and counted)
+// like Fixed's own product, whatever the factor's size: the fixed-point
+// loop moves quantities between units far apart (an overlap of a few
+// millimetres against the box's decimetres, a mode's tenth derivative)
+// without a format per pair of units.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "vines/numeric/fixed.hpp"
+
+namespace vines::numeric {
+
+class Gain {
+ public:
+  Gain() = default;
+  // From a real factor (host or build side: frexp and a rounding in double).
+  explicit Gain(double v) {
+    if (!(v == v) || v == 0.0) return;
+    int e = 0;
+    const double m = std::frexp(v, &e);  // v = m 2^e, |m| in [1/2, 1)
+    std::int64_t raw = std::llround(std::ldexp(m, 30));
+    if (raw == (std::int64_t{1} << 30) || raw == -(std::int64_t{1} << 30)) {
+      raw /= 2;
+      ++e;
+    }
+    mant_ = static_cast<std::int32_t>(raw);
+    exp_ = e;
+  }
+  static Gain from_parts(std::int32_t mant, int exp) {
+    Gain g;
+    g.mant_ = mant;
+    g.exp_ = exp;
+    return g;
+  }
+  std::int32_t mantissa() const { return mant_; }
+  int exponent() const { return exp_; }
+  explicit operator double() const { return std::ldexp(static_cast<double>(mant_), exp_ - 30); }
+  // 2^n, with no floating point.
+  static Gain pow2(int n) { return from_parts(std::int32_t{1} << 29, n + 1); }
+  // This factor times 2^n, exactly.
+  Gain shifted(int n) const { return from_parts(mant_, exp_ + n); }
+
+  // x g: (raw m) 2^(e - 30), rounded to nearest.
+  template <int F>
+  friend Fixed<F> operator*(Fixed<F> x, Gain g) {
+    const std::int64_t p = std::int64_t{x.raw()} * g.mant_;
+    const int shift = 30 - g.exp_;
+    if (shift <= 0) {
+      if (p == 0) return Fixed<F>(0);
+      if (shift < -32) return Fixed<F>::saturated(p > 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62));
+      const std::int64_t limit = std::int64_t{1} << (62 + shift);  // |p| below it: no overflow
+      if (p >= limit || p <= -limit) return Fixed<F>::saturated(p > 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62));
+      return Fixed<F>::saturated(p * (std::int64_t{1} << -shift));
+    }
+    if (shift >= 63) return Fixed<F>(0);
+    return Fixed<F>::saturated((p + (std::int64_t{1} << (shift - 1))) >> shift);
+  }
+  template <int F>
+  friend Fixed<F> operator*(Gain g, Fixed<F> x) {
+    return x * g;
+  }
+
+ private:
+  std::int32_t mant_ = 0;
+  int exp_ = 0;
+};
+
+}  // namespace vines::numeric
