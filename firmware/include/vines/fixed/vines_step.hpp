@@ -1,0 +1,226 @@
+// One sensor step of the VI NES building in fixed point (issue 34,
+// docs/fixed_point.md): the split scheme of substep_split.hpp on the model
+// of fixed/vines_model.hpp, every operation Fixed's or Gain's, so the same
+// bits on every core. The stages:
+//   1. the free motion: the frame's exact step in the modes' units, the
+//      particle's exact flight;
+//   2. the contact going on, or the first touch of the free relative motion
+//      on its cubic (in units of L over a step of length 1);
+//   3. the free relative acceleration toward the wall as a Taylor cubic
+//      from the modes' derivatives (each in its mode's own unit), and the
+//      overlap's equation (fixed/forced_contact.hpp) in the contact's units;
+//   4. the step's end: the modes and the particle moved by the force's
+//      moments; a contact still on takes q back from the overlap;
+//   5. E_e (the step's end's strain energy times h, in a 64-bit sum) and
+//      the top floor's peak (at the steps' ends).
+// Every saturation is counted (numeric::fixed_saturations()); a capped
+// contact integration too (capped).
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "vines/fixed/contact_step.hpp"
+#include "vines/fixed/forced_contact.hpp"
+#include "vines/fixed/vines_model.hpp"
+#include "vines/numeric/fixed_math.hpp"
+#include "vines/numeric/hermite.hpp"
+
+namespace vines::fixed {
+
+template <typename M>
+struct FixedVinesData {
+  using Q = typename M::Q;
+  typename M::VecX z;    // the modes
+  Q s = Q(0), sd = Q(0);  // the particle, in L and Vp
+  Q a_prev = Q(0);        // the last sample, in sa
+  int side = 0;           // the wall in contact: -1 left, +1 right, 0 none
+  Q overlap = Q(0);       // the contact's overlap [L] while one goes on
+  Q depth = Q(0);         // the deepest overlap of the contact going on or last [D]
+  Q max_depth = Q(0);     // of the whole run
+  Q peak_top = Q(0);      // largest |x_top| at a step's end [Lt]
+  numeric::Wide<40> ee;   // E_e [ee_unit]
+  std::uint32_t steps = 0, contacts = 0, events = 0, capped = 0, contact_steps = 0, max_contact_steps = 0;
+};
+
+namespace detail {
+
+// sum_j v_j g_j 2^shift.
+template <typename Q, std::size_t P, typename Z>
+Q gain_dot(const std::array<numeric::Gain, P>& g, const Z& v, int shift = 0) {
+  Q sum = Q(0);
+  for (std::size_t j = 0; j < P; ++j) sum += v(static_cast<int>(j)) * g[j].shifted(shift);
+  return sum;
+}
+
+// ee += the strain energy of the modes z times h, in ee_unit.
+template <typename M>
+void add_strain(const M& m, const typename M::VecX& z, numeric::Wide<40>* ee) {
+  for (int j = 0; j < M::kP; ++j) ee->add_product(z(j), z(j) * m.ee[static_cast<std::size_t>(j)]);
+}
+
+}  // namespace detail
+
+// The state at rest with the particle at its start moving at v0 [Vp] and
+// the first sample a0 [sa].
+template <typename M>
+void fixed_vines_init(const M& /*m*/, FixedVinesData<M>& d, typename M::Q v0, typename M::Q a0) {
+  using Q = typename M::Q;
+  d = FixedVinesData<M>{};
+  d.z.setConstant(Q(0));
+  d.sd = v0;
+  d.a_prev = a0;
+}
+
+// One sensor step to the sample a1 [sa].
+template <typename M>
+void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
+  using Q = typename M::Q;
+  using VecX = typename M::VecX;
+  using VecP = typename M::VecP;
+  constexpr int P = M::kP, K = M::kMoments;
+  const Q a0 = d.a_prev;
+  d.a_prev = a1;
+  ++d.steps;
+
+  // 1. The free motion.
+  const VecX z0 = d.z;
+  VecX z = z0;
+  m.lti.step(z, a0, a1);
+  const Q xf0 = detail::gain_dot<Q>(m.dev_x, z0.template head<P>());
+  const Q vf0 = detail::gain_dot<Q>(m.dev_v, z0.template tail<P>());
+  const Q xf1 = detail::gain_dot<Q>(m.dev_x, z.template head<P>());
+  const Q vf1 = detail::gain_dot<Q>(m.dev_v, z.template tail<P>());
+  Q s = d.s + d.sd * m.fly_v - a0 * m.fly_a0 - a1 * m.fly_a1;
+  Q sd = d.sd - (a0 + a1) * m.fly_dv;
+
+  // 2. The contact going on, or the first touch.
+  const Q r0 = d.s - xf0, rd0 = d.sd - vf0, r1 = s - xf1, rd1 = sd - vf1;
+  // Where the contact starts: its side, theta (in the step), its overlap
+  // [L] and its approach rate, u_src u_gain [V].
+  int side = d.side;
+  Q theta = Q(0), overlap0 = d.overlap, u_src = Q(0);
+  numeric::Gain u_gain = m.to_speed;
+  if (side != 0) {
+    u_src = Q(side) * rd0;
+  } else {
+    for (int sg = -1; sg <= 1 && !(side != 0 && theta == Q(0)); sg += 2) {
+      const Q g0 = sg < 0 ? m.wall_left - r0 : r0 - m.wall_right;
+      const Q g1 = sg < 0 ? m.wall_left - r1 : r1 - m.wall_right;
+      if (g0 > m.event_tol) {  // past the wall already (a contact that starts as another ended)
+        side = sg;
+        theta = Q(0);
+        overlap0 = g0;
+        u_src = Q(sg) * rd0;
+        u_gain = m.to_speed;
+        continue;
+      }
+      // The contact starts where the overlap passes event_tol (there q > 0
+      // and the overlap's equation in w moves even from a grazing touch),
+      // found by bisection to 2^-28 of the step (no quotient to saturate).
+      const numeric::Cubic<Q> c{g0 - m.event_tol, Q(sg) * rd0 * m.fly_v, g1 - m.event_tol, Q(sg) * rd1 * m.fly_v,
+                                Q(1)};
+      if (!(c.max_value() > Q(0))) continue;
+      const Q th = c.first_upcrossing(24);
+      if (side == 0 || th < theta) {
+        side = sg;
+        theta = th;
+        overlap0 = m.event_tol;
+        const Q slope = c.slope(th);
+        u_src = slope > Q(0) ? slope : Q(0);
+        u_gain = m.slope_to_speed;
+      }
+    }
+  }
+  if (side == 0) {
+    d.z = z;
+    d.s = s;
+    d.sd = sd;
+  } else {
+    // 3. The overlap's equation: g(t) from the modes' derivatives.
+    const Q sg = Q(side);
+    const VecP D0 = z0.template head<P>(), D1 = z0.template tail<P>();
+    VecP D2, D3, D4, D5;
+    const Q da = a1 - a0;
+    for (int j = 0; j < P; ++j) {
+      const std::size_t i = static_cast<std::size_t>(j);
+      D2(j) = m.dk(j) * D0(j) + m.dc(j) * D1(j) + a0 * m.dg0[i];
+      D3(j) = m.dk(j) * D1(j) + m.dc(j) * D2(j) + da * m.dg1[i];
+      D4(j) = m.dk(j) * D2(j) + m.dc(j) * D3(j);
+      D5(j) = m.dk(j) * D3(j) + m.dc(j) * D4(j);
+    }
+    // The contact's units: shrunk n times for a shallow contact (its scale
+    // q_e below 1/2), so that the overlap's equation runs at O(1) values.
+    int n = 0;
+    {
+      const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
+      const Q g_base = abs(a0 * m.ga0) + abs(detail::gain_dot<Q>(m.gd[0], D2));
+      Q q_e = contact_step(q0, u0, g_base, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
+      while (n + 1 < M::kShrinks && q_e < Q(0.5)) {
+        q_e = q_e * Q(2);
+        ++n;
+      }
+    }
+    ContactCoupling<Q, K, numeric::Gain> c = m.coupling[n];
+    c.g[0] = sg * (-(a0 * m.ga0.shifted(6 * n)) - detail::gain_dot<Q>(m.gd[0], D2, 6 * n));
+    c.g[1] = sg * (-(da * m.ga1.shifted(7 * n)) - detail::gain_dot<Q>(m.gd[1], D3, 7 * n));
+    c.g[2] = -(sg * detail::gain_dot<Q>(m.gd[2], D4, 8 * n));
+    c.g[3] = -(sg * detail::gain_dot<Q>(m.gd[3], D5, 9 * n));
+    const Q g_max =
+        abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) / Q(2) + c.h * abs(c.g[3]) / Q(6)));
+    ContactState<Q, K> y0;
+    y0.setConstant(Q(0));
+    y0(0) = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap.shifted(4 * n)));
+    y0(1) = u_src * u_gain.shifted(5 * n);
+    y0(2) = theta * c.h;
+    const ContactStep<Q> rule = contact_step(y0(0), y0(1), g_max, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max);
+    const ForcedContact<Q, K> fc = forced_contact(m.law[n], c, y0, rule.dw, rule.q_e, m.max_steps);
+    if (theta > Q(0) || d.side == 0) {
+      ++d.events;
+      d.depth = Q(0);
+    }
+    d.contact_steps += static_cast<std::uint32_t>(fc.steps);
+    if (static_cast<std::uint32_t>(fc.steps) > d.max_contact_steps) d.max_contact_steps = fc.steps;
+    if (fc.capped) ++d.capped;
+
+    // 4. The step's end.
+    const int back = -5 * n;  // the moments' unit m V 2^-5n tau^k
+    for (int k = 0; k < K; ++k) {
+      const Q mu = sg * fc.y(3 + k);
+      for (int j = 0; j < P; ++j) {
+        const std::size_t i = static_cast<std::size_t>(j);
+        z(j) += mu * m.mom_x[k][i].shifted(back);
+        z(P + j) += mu * m.mom_v[k][i].shifted(back);
+      }
+    }
+    sd -= sg * fc.y(3) * m.mu_v.shifted(back);
+    s -= sg * fc.y(4) * m.mu_x.shifted(back);
+    const Q q_max = fc.q_max * numeric::Gain::pow2(-n), q2 = q_max * q_max, q4 = q2 * q2;
+    if (q4 > d.depth) d.depth = q4;
+    const Q r_end = s - detail::gain_dot<Q>(m.dev_x, z.template head<P>());
+    const Q overlap = side < 0 ? m.wall_left - r_end : r_end - m.wall_right;
+    if (!fc.ended && overlap > Q(0)) {
+      d.side = side;
+      d.overlap = overlap;
+      const Q o = overlap * m.to_overlap;
+      if (o > d.depth) d.depth = o;
+    } else {
+      ++d.events;
+      if (d.depth > m.count_depth) ++d.contacts;
+      d.side = 0;
+      d.overlap = Q(0);
+    }
+    if (d.depth > d.max_depth) d.max_depth = d.depth;
+    d.z = z;
+    d.s = s;
+    d.sd = sd;
+  }
+
+  // 5. E_e and the top floor's peak.
+  detail::add_strain(m, d.z, &d.ee);
+  const Q xt = abs(detail::gain_dot<Q>(m.top_x, d.z.template head<P>()));
+  if (xt > d.peak_top) d.peak_top = xt;
+}
+
+}  // namespace vines::fixed
