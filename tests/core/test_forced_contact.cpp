@@ -83,8 +83,18 @@ Outcome together(const TwoBodies& su, double v0, double x0, double vf0) {
   return o;
 }
 
-// The split, step by step.
-Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) {
+// What one sensor step's contact integration gives back, in SI.
+struct ContactPart {
+  fixed::ContactState<double> y;
+  bool ended = false;
+};
+
+// The split, step by step: the overlap's equation by `integrate(c, q, u)`
+// (the coupling c with the floor's free acceleration set, the contact's q
+// and u at the step's start), then the floor's exact step plus the force's
+// moments, the particle's free flight less the impulse terms.
+template <typename Integrate>
+Outcome split_with(const TwoBodies& su, double v0, double x0, double vf0, Integrate&& integrate) {
   using M2 = Eigen::Matrix2d;
   M2 a;
   a << 0.0, 1.0, -su.k / su.mf, -su.c / su.mf;
@@ -104,11 +114,8 @@ Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) 
     double x[6] = {floor(0), floor(1)};
     for (int k = 2; k < 6; ++k) x[k] = -(su.c * x[k - 1] + su.k * x[k - 2]) / su.mf;
     for (int k = 0; k < 4; ++k) c.g[k] = -x[k + 2];
-    fixed::ContactState<double> y0 = fixed::ContactState<double>::Zero();
-    y0(0) = q;
-    y0(1) = u;
-    const fixed::ForcedContact<double> r = fixed::forced_contact(su.law, c, y0, dw, 0.0, 100000);
-    EXPECT_TRUE(r.ended || r.y(2) >= kH * (1 - 1e-12)) << "step " << step;
+    const ContactPart r = integrate(c, q, u);
+    EXPECT_TRUE(r.ended || r.y(2) >= kH * (1 - 1e-7)) << "step " << step;
     const double mu[4] = {r.y(3), r.y(4), r.y(5), r.y(6)};
     Eigen::Vector2d next = phi * floor;
     for (int k = 0; k < 4; ++k) next += akb[k] * mu[k];
@@ -132,37 +139,30 @@ Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) 
   return o;
 }
 
-// The same split with the overlap's equation in the contact's units
-// (fixed/contact_coupling.hpp: V bounds the impact speed, the moments' arm
-// in units of the sensor step) and the scalar S, stepped by the loop's rule
-// (fixed/contact_step.hpp, n steps an impact, dw at most 1): the floor and
-// the particle in double, as the loop's exact steps would give them.
+// In SI, steps of dw.
+Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) {
+  return split_with(su, v0, x0, vf0, [&](const fixed::ContactCoupling<double>& c, double q, double u) {
+    fixed::ContactState<double> y0 = fixed::ContactState<double>::Zero();
+    y0(0) = q;
+    y0(1) = u;
+    const fixed::ForcedContact<double> r = fixed::forced_contact(su.law, c, y0, dw, 0.0, 100000);
+    return ContactPart{r.y, r.ended};
+  });
+}
+
+// The overlap's equation in the contact's units (fixed/contact_coupling.hpp:
+// V bounds the impact speed, the moments' arm in units of the sensor step)
+// and the scalar S, stepped by the loop's rule (fixed/contact_step.hpp, n
+// steps an impact, dw at most 1); *steps counts its Runge-Kutta steps.
 template <typename S>
 Outcome split_in_units(const TwoBodies& su, double v0, double x0, double vf0, int n, int* steps) {
-  using M2 = Eigen::Matrix2d;
-  M2 a;
-  a << 0.0, 1.0, -su.k / su.mf, -su.c / su.mf;
-  const M2 phi = numeric::expm<M2>(a * kH);
-  Eigen::Vector2d akb[5];
-  akb[0] << 0.0, 1.0 / su.mf;
-  for (int k = 1; k < 5; ++k) akb[k] = a * akb[k - 1];
   const fixed::CouplingUnits cu{fixed::contact_units(su.m, su.law.c, 2.0 * v0), kH};
   const auto law = fixed::scaled_kernel<S>(su.law, cu.u);
-  fixed::ContactCoupling<double> c;
-  c.inv_m_star = 1.0 / su.m + 1.0 / su.mf;
-  for (int k = 1; k < 5; ++k) c.markov[k - 1] = akb[k](1);
-  c.h = kH;
-  const double inv_m_star = c.inv_m_star * su.m, law_c = static_cast<double>(law.c);
+  const double inv_m_star = (1.0 / su.m + 1.0 / su.mf) * su.m, law_c = static_cast<double>(law.c);
   const S m_star_c(1.0 / (inv_m_star * law_c)), dw_unit(1.0 / (n * std::sqrt(0.8 * law_c * inv_m_star)));
-  Eigen::Vector2d floor(x0, vf0);
-  double s = x0, sv = vf0 + v0, q = 0.0, u = v0;
-  Outcome o;
   *steps = 0;
-  for (int step = 0; step < 50; ++step) {
-    double x[6] = {floor(0), floor(1)};
-    for (int k = 2; k < 6; ++k) x[k] = -(su.c * x[k - 1] + su.k * x[k - 2]) / su.mf;
-    for (int k = 0; k < 4; ++k) c.g[k] = -x[k + 2];
-    const fixed::ContactCoupling<S> cs = fixed::scaled_coupling<S>(c, cu);
+  return split_with(su, v0, x0, vf0, [&](const fixed::ContactCoupling<double>& c_si, double q, double u) {
+    const fixed::ContactCoupling<S> c = fixed::scaled_coupling<S>(c_si, cu);
     fixed::ContactState<double> y_si = fixed::ContactState<double>::Zero();
     y_si(0) = q;
     y_si(1) = u;
@@ -170,34 +170,15 @@ Outcome split_in_units(const TwoBodies& su, double v0, double x0, double vf0, in
     const fixed::ContactState<S> y0 = y0_units.template cast<S>();
     using numeric::abs;
     using std::abs;
-    const S g_max = abs(cs.g[0]) + cs.h * (abs(cs.g[1]) + cs.h * (abs(cs.g[2]) + cs.h * abs(cs.g[3])));
+    const S g_max = abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) + c.h * abs(c.g[3])));
     const fixed::ContactStep<S> rule = fixed::contact_step(y0(0), y0(1), g_max, m_star_c, S(0.01), dw_unit, S(1));
-    const fixed::ForcedContact<S> r = fixed::forced_contact(law, cs, y0, rule.dw, rule.q_e, 4096);
-    EXPECT_FALSE(r.capped) << "step " << step;
+    const fixed::ForcedContact<S> r = fixed::forced_contact(law, c, y0, rule.dw, rule.q_e, 4096);
+    EXPECT_FALSE(r.capped);
     *steps += r.steps;
     fixed::ContactState<double> y_back;
     for (int i = 0; i < y_back.size(); ++i) y_back(i) = static_cast<double>(r.y(i));
-    const fixed::ContactState<double> y = fixed::convert_state(y_back, cu, false);
-    const double mu[4] = {y(3), y(4), y(5), y(6)};
-    Eigen::Vector2d next = phi * floor;
-    for (int k = 0; k < 4; ++k) next += akb[k] * mu[k];
-    s += sv * kH - mu[1] / su.m;
-    sv -= mu[0] / su.m;
-    floor = next;
-    o.impulse += mu[0];
-    if (r.ended) {
-      o.duration = step * kH + y(2);
-      o.rebound = -y(1) / v0;
-      break;
-    }
-    q = std::sqrt(std::sqrt(std::fmax(s - floor(0), 0.0)));
-    u = sv - floor(1);
-  }
-  o.s = s;
-  o.sv = sv;
-  o.x = floor(0);
-  o.v = floor(1);
-  return o;
+    return ContactPart{fixed::convert_state(y_back, cu, false), r.ended};
+  });
 }
 
 TEST(ForcedContact, SplitStepMatchesTheTwoBodies) {
