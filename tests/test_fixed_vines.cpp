@@ -36,8 +36,8 @@ FixedOutcome run_fixed(const SceneParams& p, const std::vector<double>& a, doubl
   for (std::size_t k = 1; k < a.size(); ++k) fixed::fixed_vines_step(fm, d, Q(a[k] / pga));
   FixedOutcome o;
   o.saturations = fixed_saturations();
-  o.peak_top = static_cast<double>(d.peak_top) * fm.top_length;
-  o.ee = static_cast<double>(d.ee) * fm.ee_unit;
+  o.peak_top = static_cast<double>(d.frame.peak_top) * fm.frame.top_length;
+  o.ee = static_cast<double>(d.frame.ee) * fm.frame.ee_unit;
   o.max_overlap = static_cast<double>(d.max_depth) * fm.cu.u.d;
   o.contacts = d.contacts;
   o.capped = d.capped;

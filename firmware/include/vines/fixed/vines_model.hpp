@@ -6,14 +6,12 @@
 // double in it.
 //
 // Units (s: the particle's displacement from where it starts, r = s - x_f
-// its position against the device floor; sa, amp, V the scales given):
-//   mode j       q / sq_j, q' / (w_j sq_j), sq_j = amp |gamma_j| sa / w_j^2
-//                (numeric/fixed_modal.hpp); its k-th derivative in w_j^k sq_j
-//   a_g          sa
+// its position against the device floor; sa, amp, V the scales given; the
+// modes, a_g, the top floor and E_e: fixed/frame.hpp):
+//   a mode's k-th derivative  w_j^k sq_j
 //   s, r, walls  L = sum_j |phi_dev,j| sq_j / 8 + the larger wall's distance
 //                (s in range while every |q_j / sq_j| < 1)
 //   s', r'       Vp = sum_j |phi_dev,j| w_j sq_j + V
-//   top floor    Lt = sum_j |phi_top,j| sq_j
 //   a contact    fixed/contact_coupling.hpp (D, V, T = D / V, m the
 //                particle's mass; the moments' arm in the sensor step h);
 //                a shallow one (its depth scale q_e below D^{1/4} / 2) in
@@ -21,7 +19,6 @@
 //                V 2^-5n, T 2^n: the Hertz force's own similarity, so q_e
 //                is O(1) again and the law's coefficients change by powers
 //                of two), n < kShrinks
-//   E_e          the sum over modes of (1/2) k_j sq_j^2 h
 #pragma once
 
 #include <array>
@@ -31,9 +28,9 @@
 
 #include "vines/fixed/contact_coupling.hpp"
 #include "vines/fixed/force_moments.hpp"
+#include "vines/fixed/frame.hpp"
 #include "vines/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
-#include "vines/numeric/fixed_modal.hpp"
 #include "vines/substep_split.hpp"
 
 namespace vines::fixed {
@@ -54,13 +51,14 @@ struct FixedVines {
   using GainP = std::array<G, P>;
   static constexpr int kP = P, kMoments = K, kShrinks = 6;
 
+  using Frame = FixedFrame<F, P>;
+
+  Frame frame;                   // the modes, the top floor, E_e
   // In double, for reading results back and for reports.
-  double h = 0, sa = 0, length = 0, speed = 0, top_length = 0, ee_unit = 0;
+  double length = 0, speed = 0;  // L, Vp [m, m/s]
   CouplingUnits cu;
 
-  ModalLti<Q, P> lti;            // the exact step in the modes' units
-  GainP dev_x, dev_v, top_x;     // x_f / L, v_f / Vp, x_top / Lt from the modes
-  GainP ee;                      // a mode's strain energy times h, in E_e's unit
+  GainP dev_x, dev_v;            // x_f / L, v_f / Vp from the modes
   // The particle's free flight: s1 = s + s' fly_v - a0 fly_a0 - a1 fly_a1,
   // s1' = s' - (a0 + a1) fly_dv.
   G fly_v, fly_a0, fly_a1, fly_dv;
@@ -103,32 +101,14 @@ FixedVines<F, Model<double, N, Dev>::kP, Law::template Kernel, K> build_fixed_vi
   const auto& l = m.lti;
   const auto& dm = m.dev;
   Out o;
-  o.h = m.h;
-  o.sa = sc.sa;
-  // The modes' units.
-  V w = V::Ones(), sq = V::Ones(), sv = V::Ones();
-  numeric::ModalScales<P> ms;
-  ms.a = sc.sa;
-  for (int j = 0; j < P; ++j) {
-    if (l.ak(j) == 0.0) continue;  // a padding mode
-    w(j) = std::sqrt(-l.ak(j));
-    sq(j) = sc.amp * std::fabs(l.bgv(j)) * sc.sa / (w(j) * w(j));
-    sv(j) = w(j) * sq(j);
-  }
-  ms.q = sq;
-  ms.v = sv;
-  o.lti = numeric::scaled_modal<F, P, P>(l, ms);
+  o.frame = build_fixed_frame<F>(m, sc.sa, sc.amp);
+  const V sq = o.frame.sq, sv = o.frame.sv, w = sv.cwiseQuotient(sq);
   o.length = m.rows.dev.cwiseAbs().dot(sq) / 8.0 + std::fmax(std::fabs(dm.wall_left), std::fabs(dm.wall_right));
   o.speed = m.rows.dev.cwiseAbs().dot(sv) + sc.v_contact;
-  o.top_length = m.rows.top.cwiseAbs().dot(sq);
   const double L = o.length, Vp = o.speed, h = m.h;
-  o.ee_unit = 0;
-  for (int j = 0; j < P; ++j) o.ee_unit += m.strain.qq(j) * sq(j) * sq(j) * h;
   for (int j = 0; j < P; ++j) {
     o.dev_x[j] = G(m.rows.dev(j) * sq(j) / L);
     o.dev_v[j] = G(m.rows.dev(j) * sv(j) / Vp);
-    o.top_x[j] = G(m.rows.top(j) * sq(j) / o.top_length);
-    o.ee[j] = G(m.strain.qq(j) * sq(j) * sq(j) * h / o.ee_unit);
   }
   o.fly_v = G(Vp * h / L);
   o.fly_a0 = G(static_cast<double>(dm.ff_a0) * sc.sa / L);

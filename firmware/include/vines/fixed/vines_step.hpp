@@ -11,8 +11,7 @@
 //      overlap's equation (fixed/forced_contact.hpp) in the contact's units;
 //   4. the step's end: the modes and the particle moved by the force's
 //      moments; a contact still on takes q back from the overlap;
-//   5. E_e (the step's end's strain energy times h, in a 64-bit sum) and
-//      the top floor's peak (at the steps' ends).
+//   5. E_e and the top floor's peak (fixed_frame_close, fixed/frame.hpp).
 // Every saturation is counted (numeric::fixed_saturations()); a capped
 // contact integration too (capped).
 #pragma once
@@ -32,45 +31,24 @@ namespace vines::fixed {
 template <typename M>
 struct FixedVinesData {
   using Q = typename M::Q;
-  typename M::VecX z;    // the modes
+  FixedFrameData<typename M::Frame> frame;  // the modes, the top floor's peak, E_e
   Q s = Q(0), sd = Q(0);  // the particle, in L and Vp
-  Q a_prev = Q(0);        // the last sample, in sa
   int side = 0;           // the wall in contact: -1 left, +1 right, 0 none
   Q overlap = Q(0);       // the contact's overlap [L] while one goes on
   Q depth = Q(0);         // the deepest overlap of the contact going on or last [D]
   Q max_depth = Q(0);     // of the whole run
-  Q peak_top = Q(0);      // largest |x_top| at a step's end [Lt]
-  numeric::Wide<40> ee;   // E_e [ee_unit]
-  std::uint32_t steps = 0, contacts = 0, events = 0, capped = 0, contact_steps = 0, max_contact_steps = 0;
+  // Contacts counted, events (starts and ends), capped integrations, sensor
+  // steps with a contact in them, Runge-Kutta steps in all and in the worst.
+  std::uint32_t contacts = 0, events = 0, capped = 0, careful = 0, contact_steps = 0, max_contact_steps = 0;
 };
-
-namespace detail {
-
-// sum_j v_j g_j 2^shift.
-template <typename Q, std::size_t P, typename Z>
-Q gain_dot(const std::array<numeric::Gain, P>& g, const Z& v, int shift = 0) {
-  Q sum = Q(0);
-  for (std::size_t j = 0; j < P; ++j) sum += v(static_cast<int>(j)) * g[j].shifted(shift);
-  return sum;
-}
-
-// ee += the strain energy of the modes z times h, in ee_unit.
-template <typename M>
-void add_strain(const M& m, const typename M::VecX& z, numeric::Wide<40>* ee) {
-  for (int j = 0; j < M::kP; ++j) ee->add_product(z(j), z(j) * m.ee[static_cast<std::size_t>(j)]);
-}
-
-}  // namespace detail
 
 // The state at rest with the particle at its start moving at v0 [Vp] and
 // the first sample a0 [sa].
 template <typename M>
-void fixed_vines_init(const M& /*m*/, FixedVinesData<M>& d, typename M::Q v0, typename M::Q a0) {
-  using Q = typename M::Q;
+void fixed_vines_init(const M& m, FixedVinesData<M>& d, typename M::Q v0, typename M::Q a0) {
   d = FixedVinesData<M>{};
-  d.z.setConstant(Q(0));
+  fixed_frame_init(m.frame, d.frame, a0);
   d.sd = v0;
-  d.a_prev = a0;
 }
 
 // One sensor step to the sample a1 [sa].
@@ -80,18 +58,18 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
   using VecX = typename M::VecX;
   using VecP = typename M::VecP;
   constexpr int P = M::kP, K = M::kMoments;
-  const Q a0 = d.a_prev;
-  d.a_prev = a1;
-  ++d.steps;
+  const Q a0 = d.frame.a_prev;
+  d.frame.a_prev = a1;
+  ++d.frame.steps;
 
   // 1. The free motion.
-  const VecX z0 = d.z;
+  const VecX z0 = d.frame.z;
   VecX z = z0;
-  m.lti.step(z, a0, a1);
-  const Q xf0 = detail::gain_dot<Q>(m.dev_x, z0.template head<P>());
-  const Q vf0 = detail::gain_dot<Q>(m.dev_v, z0.template tail<P>());
-  const Q xf1 = detail::gain_dot<Q>(m.dev_x, z.template head<P>());
-  const Q vf1 = detail::gain_dot<Q>(m.dev_v, z.template tail<P>());
+  m.frame.lti.step(z, a0, a1);
+  const Q xf0 = gain_dot<Q>(m.dev_x, z0.template head<P>());
+  const Q vf0 = gain_dot<Q>(m.dev_v, z0.template tail<P>());
+  const Q xf1 = gain_dot<Q>(m.dev_x, z.template head<P>());
+  const Q vf1 = gain_dot<Q>(m.dev_v, z.template tail<P>());
   Q s = d.s + d.sd * m.fly_v - a0 * m.fly_a0 - a1 * m.fly_a1;
   Q sd = d.sd - (a0 + a1) * m.fly_dv;
 
@@ -134,7 +112,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     }
   }
   if (side == 0) {
-    d.z = z;
+    d.frame.z = z;
     d.s = s;
     d.sd = sd;
   } else {
@@ -155,7 +133,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     int n = 0;
     {
       const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
-      const Q g_base = abs(a0 * m.ga0) + abs(detail::gain_dot<Q>(m.gd[0], D2));
+      const Q g_base = abs(a0 * m.ga0) + abs(gain_dot<Q>(m.gd[0], D2));
       Q q_e = contact_step(q0, u0, g_base, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
       while (n + 1 < M::kShrinks && q_e < Q(0.5)) {
         q_e = q_e * Q(2);
@@ -163,10 +141,10 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       }
     }
     ContactCoupling<Q, K, numeric::Gain> c = m.coupling[n];
-    c.g[0] = sg * (-(a0 * m.ga0.shifted(6 * n)) - detail::gain_dot<Q>(m.gd[0], D2, 6 * n));
-    c.g[1] = sg * (-(da * m.ga1.shifted(7 * n)) - detail::gain_dot<Q>(m.gd[1], D3, 7 * n));
-    c.g[2] = -(sg * detail::gain_dot<Q>(m.gd[2], D4, 8 * n));
-    c.g[3] = -(sg * detail::gain_dot<Q>(m.gd[3], D5, 9 * n));
+    c.g[0] = sg * (-(a0 * m.ga0.shifted(6 * n)) - gain_dot<Q>(m.gd[0], D2, 6 * n));
+    c.g[1] = sg * (-(da * m.ga1.shifted(7 * n)) - gain_dot<Q>(m.gd[1], D3, 7 * n));
+    c.g[2] = -(sg * gain_dot<Q>(m.gd[2], D4, 8 * n));
+    c.g[3] = -(sg * gain_dot<Q>(m.gd[3], D5, 9 * n));
     const Q g_max =
         abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) / Q(2) + c.h * abs(c.g[3]) / Q(6)));
     ContactState<Q, K> y0;
@@ -180,6 +158,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       ++d.events;
       d.depth = Q(0);
     }
+    ++d.careful;
     d.contact_steps += static_cast<std::uint32_t>(fc.steps);
     if (static_cast<std::uint32_t>(fc.steps) > d.max_contact_steps) d.max_contact_steps = fc.steps;
     if (fc.capped) ++d.capped;
@@ -198,7 +177,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     s -= sg * fc.y(4) * m.mu_x.shifted(back);
     const Q q_max = fc.q_max * numeric::Gain::pow2(-n), q2 = q_max * q_max, q4 = q2 * q2;
     if (q4 > d.depth) d.depth = q4;
-    const Q r_end = s - detail::gain_dot<Q>(m.dev_x, z.template head<P>());
+    const Q r_end = s - gain_dot<Q>(m.dev_x, z.template head<P>());
     const Q overlap = side < 0 ? m.wall_left - r_end : r_end - m.wall_right;
     if (!fc.ended && overlap > Q(0)) {
       d.side = side;
@@ -212,15 +191,13 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       d.overlap = Q(0);
     }
     if (d.depth > d.max_depth) d.max_depth = d.depth;
-    d.z = z;
+    d.frame.z = z;
     d.s = s;
     d.sd = sd;
   }
 
   // 5. E_e and the top floor's peak.
-  detail::add_strain(m, d.z, &d.ee);
-  const Q xt = abs(detail::gain_dot<Q>(m.top_x, d.z.template head<P>()));
-  if (xt > d.peak_top) d.peak_top = xt;
+  fixed_frame_close(m.frame, d.frame);
 }
 
 }  // namespace vines::fixed
