@@ -150,7 +150,10 @@ TEST(SceneError, HostKeys) {
   expect_refused(kBase + "[output]\nrate_hz = 300\n", {"output.rate_hz", "divide"});
   expect_refused(kBase + "[output]\nrate_hz = 0\n", {"output.rate_hz", "> 0"});
   expect_refused(kBase + "[loop]\nsensor_rate_hz = 0\n", {"loop.sensor_rate_hz"});
-  expect_refused(kBase + "[loop]\nscalar = \"half\"\n", {"loop.scalar", "\"float\""});
+  expect_refused(kBase + "[loop]\nscalar = \"half\"\n", {"loop.scalar", "\"fixed\""});
+  expect_refused(kBase + "[loop]\nfixed_accel_mps2 = 0\n", {"loop.fixed_accel_mps2", "(0, 1000]"});
+  expect_refused(kBase + "[loop]\nfixed_amplification = 0.5\n", {"loop.fixed_amplification", "[1, 1000]"});
+  expect_refused(kBase + "[loop]\nfixed_contact_speed_mps = nan\n", {"loop.fixed_contact_speed_mps", "(0, 100]"});
   expect_refused("[scene]\nname = \"\"\n" + kBase, {"bad.toml:2:", "scene.name", "empty"});
   expect_refused("[device]\nkind = \"none\"\n", {"record", "missing"});
   expect_refused("[record]\nformat = \"at2\"\n", {"record.path", "required"});

@@ -160,6 +160,11 @@ TEST(SceneReadme, DefaultsAreTheCodes) {
   EXPECT_EQ(l.divergence_limit_m, m.divergence_limit_m);
   EXPECT_EQ(l.contact_scheme, m.contact_scheme);
   EXPECT_EQ(l.bounded_substeps, m.bounded_substeps);
+  EXPECT_EQ(l.split_steps, m.split_steps);
+  const vines::FixedParams &f = a.fixed, &g = b.fixed;
+  EXPECT_EQ(f.accel_mps2, g.accel_mps2);
+  EXPECT_EQ(f.amplification, g.amplification);
+  EXPECT_EQ(f.contact_speed_mps, g.contact_speed_mps);
   EXPECT_EQ(readme.scalar, bare.scalar);
   EXPECT_EQ(readme.record.format, bare.record.format);
   EXPECT_EQ(readme.record.units, bare.record.units);

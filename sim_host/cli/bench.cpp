@@ -94,10 +94,10 @@ void add_bench(CLI::App& vines) {
   cmd->add_option("SCENE.toml", a->scenes, "scene files (see data/scenes/README.md)")->required();
   add_number_list(*cmd, "--rates", &opt.rates_hz, "sensor rates [Hz] (default: the scene's)");
   add_number_list(*cmd, "--rtols", &opt.rtols, "contact sub-step tolerances (default: the scene's)");
-  cmd->add_option("--scalars", opt.scalars, "double,float (default: the scene's scalar)")
+  cmd->add_option("--scalars", opt.scalars, "double,float,fixed (default: double and float; fixed needs the split scheme)")
       ->type_name("LIST")
       ->delimiter(',')
-      ->check(CLI::IsMember({"double", "float"}));
+      ->check(CLI::IsMember({"double", "float", "fixed"}));
   cmd->add_option("--schemes", opt.schemes,
                   "contact schemes: adaptive (a line per --rtols), bounded (a line per --substeps), split (a line "
                   "per --split-steps) (default: the scene's loop.contact_scheme)")

@@ -24,6 +24,9 @@ int image(const ImageArgs& a) {
   using namespace vines::host;
   const std::string& out = a.out;
   const Scene scene = load_scene(a.scene_path);
+  if (a.scalar.empty() && scene.scalar == Scalar::kFixed)
+    throw std::runtime_error(scene.path + ": loop.scalar = \"fixed\": there is no fixed-point model image yet; "
+                             "pass --scalar double or --scalar float");
   const Scalar scalar = a.scalar.empty() ? scene.scalar : a.scalar == "float" ? Scalar::kFloat : Scalar::kDouble;
   const vines::SceneParams& p = scene.params;
   const std::vector<std::uint8_t> img = build_engine(p, scalar, scene.path)->model_image();

@@ -55,6 +55,7 @@ struct RunTotals {
   double max_overlap = 0;
   Ledger ledger;
   Counters count;
+  std::int64_t fixed_saturations = 0;  // fixed-point operations saturated (loop.scalar = "fixed")
 };
 
 // What the loop holds after a step, cheap to read every step (no outputs

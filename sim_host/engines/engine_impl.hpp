@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim_host/engines/engine.hpp"
+#include "sim_host/engines/model_info.hpp"
 #include "vines/build_model.hpp"
 #include "vines/model_image.hpp"
 #include "vines/sim.hpp"
@@ -41,25 +42,7 @@ class EngineImpl final : public Engine {
     return {};
   }
 
-  ModelInfo info() const override {
-    const Model<S, N, Dev>& m = *model_;
-    ModelInfo out;
-    out.stories = N;
-    for (int j = 0; j < N; ++j) {
-      out.frequency_hz[j] = m.modal.frequency_hz()(j);
-      out.zeta[j] = m.modal.zeta(j);
-      out.gamma[j] = m.modal.gamma(j);
-      out.m_eff[j] = m.modal.m_eff(j);
-      // Shapes normalised to the top floor's participation: phi_j * gamma_j.
-      for (int i = 0; i < N; ++i) out.mode_shapes[j][i] = m.modal.phi(i, j) * m.modal.gamma(j);
-    }
-    out.total_mass = m.frame.m.sum();
-    out.sensor_period = m.h;
-    out.device_floor = m.floor + 1;
-    if constexpr (Dev::kKind == DeviceKind::kTmd) out.tmd = m.dev.design;
-    if constexpr (Dev::kKind == DeviceKind::kVines) out.vines = m.dev.design;
-    return out;
-  }
+  ModelInfo info() const override { return model_info(*model_); }
 
   void init(double a0) override { vines::init(*model_, *data_, static_cast<S>(a0)); }
   void step(double a1) override { vines::step(*model_, *data_, static_cast<S>(a1)); }

@@ -268,6 +268,12 @@ json RunReport::to_json() const {
     j["bare"] = response_json(b, info.stories);
   }
   j["contacts"] = t.count.contacts;
+  if (scalar == Scalar::kFixed) {
+    j["fixed_saturations"] = t.fixed_saturations;
+    j["fixed_scales"] = {{"accel_mps2", p.fixed.accel_mps2},
+                         {"amplification", p.fixed.amplification},
+                         {"contact_speed_mps", p.fixed.contact_speed_mps}};
+  }
   if (p.device.kind == DeviceKind::kVines) j["max_overlap_m"] = t.max_overlap;
   if (p.loop.energy_ledger) {
     const Ledger& l = t.ledger;

@@ -76,6 +76,11 @@ RunStatus run_status(const RunTotals& t, const SceneParams& p, const ModelInfo& 
                                        "loop.split_steps) before the step's end: the rest of its force was left "
                                        "to the next step",
                                        static_cast<long long>(k.cap_hits), kSplitCap * loop.split_steps, kSplitCap));
+  // Fixed point: a value past its format's range was clamped to it.
+  if (t.fixed_saturations > 0)
+    add("fixed_saturations", format("%lld fixed-point operations saturated: a value passed its unit's range (raise "
+                                    "loop.fixed_accel_mps2 or loop.fixed_amplification, docs/fixed_point.md)",
+                                    static_cast<long long>(t.fixed_saturations)));
   // The energy balance, when the ledger kept it.
   s.energy_checked = loop.energy_ledger;
   const double bound = scalar == Scalar::kFloat ? kResidualBoundFloat : kResidualBoundDouble;

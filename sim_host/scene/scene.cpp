@@ -29,7 +29,8 @@
 //             contact_count_depth_m, energy_ledger (default false),
 //             floor_peaks (default true), divergence_limit_m,
 //             contact_scheme = "adaptive" | "bounded" | "split", bounded_substeps,
-//             split_steps, scalar = "double" | "float"
+//             split_steps, scalar = "double" | "float" | "fixed",
+//             fixed_accel_mps2, fixed_amplification, fixed_contact_speed_mps
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
 //
 // Rules:
@@ -207,7 +208,7 @@ void read_record(const Section& s, Scene* scene) {
 }
 
 // ---- [loop] ----
-void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
+void read_loop(const Section& s, LoopParams* l, FixedParams* f, Scalar* scalar) {
   s.read("sensor_rate_hz", &l->sensor_rate_hz);
   s.read("contact_rtol", &l->contact_rtol);
   s.read("max_substeps_per_step", &l->max_substeps_per_step);
@@ -222,7 +223,11 @@ void read_loop(const Section& s, LoopParams* l, Scalar* scalar) {
                           &l->contact_scheme);
   s.read("bounded_substeps", &l->bounded_substeps);
   s.read("split_steps", &l->split_steps);
-  s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}}, scalar);
+  s.read("fixed_accel_mps2", &f->accel_mps2);
+  s.read("fixed_amplification", &f->amplification);
+  s.read("fixed_contact_speed_mps", &f->contact_speed_mps);
+  s.choose<Scalar>("scalar", {{"double", Scalar::kDouble}, {"float", Scalar::kFloat}, {"fixed", Scalar::kFixed}},
+                   scalar);
 }
 
 // ---- [output] (host only; needs a validated sensor rate) ----
@@ -283,7 +288,7 @@ const std::initializer_list<std::string_view> kRecordKeys = {"path",   "format",
 const std::initializer_list<std::string_view> kLoopKeys = {
     "sensor_rate_hz", "contact_rtol",   "max_substeps_per_step", "contact_count_depth_m", "energy_ledger",
     "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "split_steps",
-    "scalar"};
+    "scalar",         "fixed_accel_mps2",   "fixed_amplification", "fixed_contact_speed_mps"};
 const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries"};
 }  // namespace
 
@@ -332,7 +337,7 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
   if (!record.present())
     fail(origin, nullptr, "record", "missing table: the scene needs a [record]");
   read_record(record, &scene);
-  read_loop(Section(origin, root, "loop", kLoopKeys), &p.loop, &scene.scalar);
+  read_loop(Section(origin, root, "loop", kLoopKeys), &p.loop, &p.fixed, &scene.scalar);
 
   // The shared range checks, reported at the offending key's line.
   if (const ParamError e = validate(p); !e.ok()) {

@@ -188,8 +188,9 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   const Truth truth = load_truth(scene, opt.reference_dir);
   std::vector<Scalar> scalars;
   for (const std::string& s : opt.scalars.empty() ? std::vector<std::string>{"double", "float"} : opt.scalars) {
-    if (s != "double" && s != "float") throw std::runtime_error("--scalars: unknown scalar '" + s + "'");
-    scalars.push_back(s == "float" ? Scalar::kFloat : Scalar::kDouble);
+    if (s != "double" && s != "float" && s != "fixed")
+      throw std::runtime_error("--scalars: unknown scalar '" + s + "' (double, float or fixed)");
+    scalars.push_back(s == "float" ? Scalar::kFloat : s == "fixed" ? Scalar::kFixed : Scalar::kDouble);
   }
   const std::vector<double> rates = opt.rates_hz.empty() ? std::vector<double>{scene.params.loop.sensor_rate_hz} : opt.rates_hz;
   // The tolerance only matters when there is a contact law to sub-step.
@@ -207,6 +208,11 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   for (Scalar s : scalars)
     for (double rate : rates)
       for (const std::string& scheme : schemes) {
+        if (s == Scalar::kFixed && contacts && scheme != "split") {
+          std::fprintf(stderr, "vines bench: no fixed-point line for the %s scheme (fixed point runs the split one)\n",
+                       scheme.c_str());
+          continue;
+        }
         if (scheme == "adaptive") {
           for (double rtol : rtols)
             lines.push_back(firmware_line(scene, s, rate, rtol, ContactScheme::kAdaptive, 0, truth, opt));

@@ -47,7 +47,7 @@ struct BenchLine {
 };
 
 struct BenchOptions {
-  std::vector<std::string> scalars;  // "double", "float"; empty: both
+  std::vector<std::string> scalars;  // "double", "float", "fixed"; empty: double and float
   std::vector<double> rates_hz;      // empty: the scene's own
   std::vector<double> rtols;         // contact sub-step tolerances; empty: the scene's own
   // Contact schemes ("adaptive": a line per rtol; "bounded": a line per

@@ -48,7 +48,7 @@ class Cache {
     const std::string key = key_of(record_key(r), r.table, {"frame", "loop"},
                                    {"loop.contact_rtol", "loop.max_substeps_per_step", "loop.contact_count_depth_m",
                                     "loop.contact_scheme", "loop.bounded_substeps", "loop.split_steps",
-                                    "loop.floor_peaks"});
+                                    "loop.floor_peaks", "loop.fixed_contact_speed_mps"});
     return get<RunTotals>(bares_, key, [&] { return run_totals(r.scene, p, *excitation(r), stop_); });
   }
   // The VI NES design a scene builds (its law's calibration: the same for

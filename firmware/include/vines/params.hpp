@@ -147,10 +147,21 @@ struct LoopParams {
   int split_steps = 64;
 };
 
+// The fixed-point engine's scales (fixed/frame.hpp, fixed/vines_model.hpp;
+// scene keys loop.fixed_*): the ground acceleration its units are made for
+// [m/s^2], the modes' dynamic amplification they leave room for, and a speed
+// that bounds the impacts [m/s]. Past them a run saturates (counted).
+struct FixedParams {
+  double accel_mps2 = 9.80665;
+  double amplification = 10.0;
+  double contact_speed_mps = 1.5;
+};
+
 struct SceneParams {
   FrameParams frame;
   DeviceParams device;
   LoopParams loop;
+  FixedParams fixed;
 };
 
 }  // namespace vines

@@ -115,6 +115,16 @@ inline ParamError validate(const LoopParams& l) {
   return {};
 }
 
+inline ParamError validate(const FixedParams& f) {
+  if (!(std::isfinite(f.accel_mps2) && f.accel_mps2 > 0.0 && f.accel_mps2 <= 1000.0))
+    return {"loop.fixed_accel_mps2", "must be in (0, 1000] m/s^2"};
+  if (!(std::isfinite(f.amplification) && f.amplification >= 1.0 && f.amplification <= 1000.0))
+    return {"loop.fixed_amplification", "must be in [1, 1000]"};
+  if (!(std::isfinite(f.contact_speed_mps) && f.contact_speed_mps > 0.0 && f.contact_speed_mps <= 100.0))
+    return {"loop.fixed_contact_speed_mps", "must be in (0, 100] m/s"};
+  return {};
+}
+
 inline ParamError validate(const SceneParams& s) {
   ParamError e = validate(s.frame);
   if (!e.ok()) return e;
@@ -124,6 +134,8 @@ inline ParamError validate(const SceneParams& s) {
       law_impulsive(s.device.vines.law))
     return {"loop.contact_scheme", "\"split\" integrates a contact's force over time: it needs a law with a "
                                    "finite contact duration (vines.law), not an instantaneous impact"};
+  e = validate(s.fixed);
+  if (!e.ok()) return e;
   return validate(s.loop);
 }
 

@@ -7,7 +7,7 @@
 // Units (sa, amp the scales given):
 //   mode j       q / sq_j, q' / (w_j sq_j), sq_j = amp |gamma_j| sa / w_j^2
 //   a_g          sa
-//   top floor    Lt = sum_j |phi_top,j| sq_j
+//   top floor    Lt = sum_j |phi_top,j| sq_j, its speed Vt = sum_j |phi_top,j| w_j sq_j
 //   E_e          the sum over modes of (1/2) k_j sq_j^2 h
 #pragma once
 
@@ -33,11 +33,11 @@ struct FixedFrame {
   static constexpr int kP = P;
 
   // In double, for reading results back and for reports.
-  double h = 0, sa = 0, top_length = 0, ee_unit = 0;
+  double h = 0, sa = 0, top_length = 0, top_speed = 0, ee_unit = 0;
   Eigen::Matrix<double, P, 1> sq, sv;  // each mode's position and velocity unit (1 for padding modes)
 
   ModalLti<Q, P> lti;  // the exact step in the modes' units
-  GainP top_x;         // x_top / Lt from the modes
+  GainP top_x, top_v;  // x_top / Lt, v_top / Vt from the modes
   GainP ee;            // a mode's strain energy times h, in E_e's unit
 };
 
@@ -65,10 +65,12 @@ FixedFrame<F, Model<double, N, Dev>::kP> build_fixed_frame(const Model<double, N
   ms.v = o.sv;
   o.lti = numeric::scaled_modal<F, P, P>(l, ms);
   o.top_length = m.rows.top.cwiseAbs().dot(o.sq);
+  o.top_speed = m.rows.top.cwiseAbs().dot(o.sv);
   o.ee_unit = 0;
   for (int j = 0; j < P; ++j) o.ee_unit += m.strain.qq(j) * o.sq(j) * o.sq(j) * m.h;
   for (int j = 0; j < P; ++j) {
     o.top_x[j] = G(m.rows.top(j) * o.sq(j) / o.top_length);
+    o.top_v[j] = G(m.rows.top(j) * o.sv(j) / o.top_speed);
     o.ee[j] = G(m.strain.qq(j) * o.sq(j) * o.sq(j) * m.h / o.ee_unit);
   }
   return o;
@@ -80,6 +82,7 @@ struct FixedFrameData {
   typename Fr::VecX z;    // the modes
   Q a_prev = Q(0);        // the last sample, in sa
   Q peak_top = Q(0);      // largest |x_top| at a step's end [Lt]
+  Q peak_top_velocity = Q(0);  // largest |v_top| at a step's end [Vt]
   numeric::Wide<40> ee;   // E_e [ee_unit]
   std::uint32_t steps = 0, peak_step = 0;  // steps taken; the one that ended at the peak
 };
@@ -102,7 +105,7 @@ void fixed_frame_init(const Fr& /*fr*/, FixedFrameData<Fr>& d, typename Fr::Q a0
 }
 
 // A step's end: E_e (the strain energy at the end times h, in a 64-bit sum)
-// and the top floor's peak.
+// and the top floor's peaks.
 template <typename Fr>
 void fixed_frame_close(const Fr& fr, FixedFrameData<Fr>& d) {
   using Q = typename Fr::Q;
@@ -112,6 +115,8 @@ void fixed_frame_close(const Fr& fr, FixedFrameData<Fr>& d) {
     d.peak_top = xt;
     d.peak_step = d.steps;
   }
+  const Q vt = abs(gain_dot<Q>(fr.top_v, d.z.template tail<Fr::kP>()));
+  if (vt > d.peak_top_velocity) d.peak_top_velocity = vt;
 }
 
 // One sensor step of the bare frame to the sample a1 [sa].
