@@ -14,7 +14,7 @@
 //   s', r'       Vp = sum_j |phi_dev,j| w_j sq_j + V
 //   a contact    fixed/contact_coupling.hpp (D, V, T = D / V, m the
 //                particle's mass; the moments' arm in the sensor step h);
-//                a shallow one (its depth scale q_e below D^{1/4} / 2) in
+//                a shallow one (its depth scale q_e below 0.4 D^{1/4}) in
 //                the units of an impact 2^-5n times as fast (D 2^-4n,
 //                V 2^-5n, T 2^n: the Hertz force's own similarity, so q_e
 //                is O(1) again and the law's coefficients change by powers

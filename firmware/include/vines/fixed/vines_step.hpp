@@ -129,13 +129,16 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       D5(j) = m.dk(j) * D3(j) + m.dc(j) * D4(j);
     }
     // The contact's units: shrunk n times for a shallow contact (its scale
-    // q_e below 1/2), so that the overlap's equation runs at O(1) values.
+    // q_e below 0.4), so that the overlap's equation runs at O(1) values:
+    // q_e ends in [0.4, 0.8), leaving room for a contact deeper than the
+    // step's start predicts (at q = 1 the overlap's rate du/dw = 4 q^3 F m /
+    // m* reaches Q3.28's 8 in an elastic impact at V).
     int n = 0;
     {
       const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
       const Q g_base = abs(a0 * m.ga0) + abs(gain_dot<Q>(m.gd[0], D2));
       Q q_e = contact_step(q0, u0, g_base, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
-      while (n + 1 < M::kShrinks && q_e < Q(0.5)) {
+      while (n + 1 < M::kShrinks && q_e < Q(0.4)) {
         q_e = q_e * Q(2);
         ++n;
       }
