@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 #include <thread>
+#include <vector>
 
 #include "support.hpp"
 #include "vines/build_model.hpp"
@@ -30,6 +31,22 @@ TEST(Fixed, RoundsToNearestAndSaturates) {
   EXPECT_EQ(Q(4.0) * Q(-4.0), Q::lowest());
   EXPECT_EQ(Q(1e9), Q::max());
   EXPECT_EQ(fixed_saturations(), 4u);
+}
+
+// A division by an integer (one 32-bit division) is the division by that
+// integer as a Fixed (64-bit), bit for bit: random values and the range's
+// edges, every divisor the contact step uses and their negatives.
+TEST(Fixed, DivisionByAnIntegerIsTheFixedDivision) {
+  std::mt19937 rng(34);
+  std::uniform_int_distribution<std::int32_t> raw(std::numeric_limits<std::int32_t>::min(),
+                                                  std::numeric_limits<std::int32_t>::max());
+  std::vector<Q> values{Q::max(), Q::lowest(), Q::from_raw(1), Q::from_raw(-1), Q(0.0), Q(7.0), Q(-5.0)};
+  for (int i = 0; i < 100000; ++i) values.push_back(Q::from_raw(raw(rng)));
+  fixed_saturations() = 0;
+  for (const Q x : values)
+    for (int d : {1, 2, 3, 4, 5, 6, 7, -1, -2, -6}) ASSERT_EQ((x / d).raw(), (x / Q(d)).raw()) << x.raw() << " / " << d;
+  const std::uint32_t both = fixed_saturations();  // Q::lowest() / -1, counted once by each
+  EXPECT_EQ(both, 2u);
 }
 
 TEST(Fixed, EigenArraysTakeIt) {

@@ -69,7 +69,7 @@ S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y)
   S sum = S(0);
   for (int i = 0; i < K; ++i) {
     S poly = c.markov[K - 1];
-    for (int j = K - 1 - i; j > 0; --j) poly = c.markov[i + j - 1] + x * poly / S(j);
+    for (int j = K - 1 - i; j > 0; --j) poly = c.markov[i + j - 1] + x * poly / j;
     sum += poly * y(3 + i);
   }
   return sum;
@@ -80,7 +80,7 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& 
   const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q;
   const contact::Force<S> f = law.regular(q, u);
   const S force = f.total();
-  const S g = c.g[0] + t * (c.g[1] + t * (c.g[2] / S(2) + t * c.g[3] / S(6)));
+  const S g = c.g[0] + t * (c.g[1] + t * (c.g[2] / 2 + t * c.g[3] / 6));
   ContactState<S, K> d;
   d(0) = u;
   d(1) = j * (g - floor_response(c, y) - force * c.inv_m_star);
@@ -90,7 +90,7 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& 
   const S r = (c.h - t) * c.r_scale;
   for (int k = 0; k < K; ++k) {
     d(3 + k) = term;
-    term = term * r / S(k + 1);
+    term = term * r / (k + 1);
   }
   d(K + 3) = j * f.dissipative * u;
   return d;
@@ -112,7 +112,7 @@ ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R
                                    S dw, S q_ref, int max_steps) {
   using State = ContactState<S, K>;
   auto rate = [&](const State& y) { return detail::contact_rate(law, c, y); };
-  const S reach = q_ref / S(2), most = S(kMaxStretch) * dw;
+  const S reach = q_ref / 2, most = S(kMaxStretch) * dw;
   ForcedContact<S, K> out;
   out.y = y0;
   out.q_max = y0(0);

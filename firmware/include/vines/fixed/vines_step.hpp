@@ -149,7 +149,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     c.g[2] = -(sg * gain_dot<Q>(m.gd[2], D4, 8 * n));
     c.g[3] = -(sg * gain_dot<Q>(m.gd[3], D5, 9 * n));
     const Q g_max =
-        abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) / Q(2) + c.h * abs(c.g[3]) / Q(6)));
+        abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) / 2 + c.h * abs(c.g[3]) / 6));
     ContactState<Q, K> y0;
     y0.setConstant(Q(0));
     y0(0) = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap.shifted(4 * n)));

@@ -67,6 +67,14 @@ class Fixed {
     if (b.raw_ == 0) return from_raw(saturate(a.raw_ >= 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62)));
     return from_raw(saturate((std::int64_t{a.raw_} * (std::int64_t{1} << F)) / b.raw_));
   }
+  // By an integer: the quotient a / (b 2^F) of the division above, bit for
+  // bit (both truncate the same rational), in one 32-bit division (a
+  // Cortex-M3's SDIV, not the 64-bit library division above).
+  friend Fixed operator/(Fixed a, int b) {
+    if (b == 0) return from_raw(saturate(a.raw_ >= 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62)));
+    if (b == -1) return -a;
+    return from_raw(static_cast<Raw>(a.raw_ / b));
+  }
   Fixed& operator+=(Fixed b) { return *this = *this + b; }
   Fixed& operator-=(Fixed b) { return *this = *this - b; }
   Fixed& operator*=(Fixed b) { return *this = *this * b; }

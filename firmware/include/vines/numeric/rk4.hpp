@@ -9,7 +9,7 @@ namespace vines::numeric {
 
 template <typename Vec, typename S, typename F>
 Vec rk4_step(F&& f, const Vec& y, S h) {
-  const S half = h / S(2), sixth = h / S(6), third = h / S(3);
+  const S half = h / 2, sixth = h / 6, third = h / 3;
   const Vec k1 = f(y);
   const Vec k2 = f(Vec(y + k1 * half));
   const Vec k3 = f(Vec(y + k2 * half));
