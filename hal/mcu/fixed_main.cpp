@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "semihost.h"
+#include "two_tone.hpp"
 #include "vines/frame_presets.hpp"
 #include "vines/hal/port.hpp"
 #include "vines/build_model.hpp"
@@ -18,19 +19,7 @@ namespace {
 using Q = vines::numeric::Fixed<28>;
 vines::Model<double, 10, vines::NoDevice> g_model;
 
-double ground(long k) {  // m/s^2: near the first mode, plus a faster tone
-  const double t = static_cast<double>(k) * 1e-3;
-  return 2.0 * std::sin(2 * 3.14159265358979 * 0.5 * t) + 1.0 * std::sin(2 * 3.14159265358979 * 2.1 * t);
-}
-
-void put_result(const char* what, std::uint32_t worst, std::uint64_t total, long steps) {
-  vines_semihost_puts(what);
-  vines_semihost_puts(": instructions/step max ");
-  vines_semihost_put_int(static_cast<long long>(worst) * 5);
-  vines_semihost_puts(", mean ");
-  vines_semihost_put_int(static_cast<long long>(total * 5 / static_cast<std::uint64_t>(steps)));
-  vines_semihost_puts("\n");
-}
+double ground(long k) { return vines::mcu::two_tone(k, 2.0); }
 
 }  // namespace
 
@@ -72,8 +61,8 @@ int main() {
     peak = std::fmax(peak, std::fabs(xd));
     max_err = std::fmax(max_err, std::fabs(xq - xd));
   }
-  put_result("Q3.28 modal step", worst_q, total_q, kSteps);
-  put_result("double modal step (software FP)", worst_d, total_d, kSteps);
+  vines::mcu::put_step_cost("Q3.28 modal step", worst_q, total_q, kSteps);
+  vines::mcu::put_step_cost("double modal step (software FP)", worst_d, total_d, kSteps);
   vines_semihost_puts("largest top-floor error / peak, in 1e-9: ");
   vines_semihost_put_int(std::llround(max_err / peak * 1e9));
   vines_semihost_puts("; saturations: ");

@@ -1,6 +1,6 @@
 // The whole VI NES step in fixed point on an FPU-less core (Cortex-M3,
 // MPS2-AN385, soft-float ABI; issue 34): the paper's 10-story frame and
-// sphere (Kuwabara) at 1 kHz, the Q3.28 split step (vines/fixed/vines_step.hpp)
+// sphere (the default law, Kuwabara-Kono) at 1 kHz, the Q3.28 split step (vines/fixed/vines_step.hpp)
 // beside the double loop's split scheme in software floating point, on the
 // same 10 s of a two-tone ground motion that makes contacts (host: 8).
 // Prints each one's instructions per step (worst and mean; timer 1 at 25 MHz
@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "semihost.h"
+#include "two_tone.hpp"
 #include "vines/build_model.hpp"
 #include "vines/fixed/vines_step.hpp"
 #include "vines/frame_presets.hpp"
@@ -19,7 +20,7 @@
 
 namespace {
 
-constexpr vines::ContactLaw kLaw = vines::ContactLaw::kKuwabara;
+constexpr vines::ContactLaw kLaw = vines::VinesParams{}.law;  // the default law (params.hpp)
 using Dev = vines::VinesDevice<kLaw>;
 vines::Model<double, 10, Dev> g_model;
 vines::Data<double, 10, Dev> g_data;
@@ -29,19 +30,7 @@ using FixedModel = decltype(vines::fixed::build_fixed_vines<28, vines::kSplitMom
 FixedModel g_fixed;
 vines::fixed::FixedVinesData<FixedModel> g_state;
 
-double ground(long k) {  // m/s^2: at the first mode, plus a faster tone (bare peak 0.34 m)
-  const double t = static_cast<double>(k) * 1e-3;
-  return 0.2 * std::sin(2 * 3.14159265358979 * 0.5 * t) + 1.0 * std::sin(2 * 3.14159265358979 * 2.1 * t);
-}
-
-void put_result(const char* what, std::uint32_t worst, std::uint64_t total, long steps) {
-  vines_semihost_puts(what);
-  vines_semihost_puts(": instructions/step max ");
-  vines_semihost_put_int(static_cast<long long>(worst) * 5);
-  vines_semihost_puts(", mean ");
-  vines_semihost_put_int(static_cast<long long>(total * 5 / static_cast<std::uint64_t>(steps)));
-  vines_semihost_puts("\n");
-}
+double ground(long k) { return vines::mcu::two_tone(k, 0.2); }
 
 }  // namespace
 
@@ -78,8 +67,8 @@ int main() {
     total_q += dq;
     total_d += dd;
   }
-  put_result("Q3.28 VI NES step", worst_q, total_q, kSteps);
-  put_result("double VI NES step, split scheme (software FP)", worst_d, total_d, kSteps);
+  vines::mcu::put_step_cost("Q3.28 VI NES step", worst_q, total_q, kSteps);
+  vines::mcu::put_step_cost("double VI NES step, split scheme (software FP)", worst_d, total_d, kSteps);
   const double peak_q = static_cast<double>(g_state.frame.peak_top) * g_fixed.frame.top_length;
   const double peak_d = static_cast<double>(g_data.peak_top);
   vines_semihost_puts("RAM: fixed model ");
