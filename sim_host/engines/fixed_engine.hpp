@@ -93,8 +93,7 @@ class FixedEngine final : public Engine {
   void init(double a0) override {
     const std::uint32_t sat0 = numeric::fixed_saturations();
     count_ = Counters{};
-    last_good_ = std::isfinite(a0) ? a0 : 0.0;
-    if (!std::isfinite(a0)) ++count_.bad_samples;
+    last_good_ = 0;  // a non-finite first sample is held at 0 (and counted)
     Q v0 = Q(0);
     if constexpr (kVines) v0 = Q(dm_->dev.v0 / fm_->speed);
     Of::init(*fm_, *fd_, v0, sample(a0));
