@@ -184,14 +184,8 @@ class FixedEngine final : public Engine {
   // The fixed state read back in double, in a Data of the double model (for
   // the double model's output functions): modes, particle, contact force.
   const DData& shadow() const {
-    const auto& fd = Of::frame(*fd_);
-    const auto& fr = fm_frame();
     DData& d = *shadow_;
-    d.z.setZero();
-    for (int j = 0; j < P; ++j) {
-      d.z(j) = static_cast<double>(fd.z(j)) * fr.sq(j);
-      d.z(P + j) = static_cast<double>(fd.z(P + j)) * fr.sv(j);
-    }
+    shadow_modes();
     if constexpr (kVines) {
       const FM& m = *fm_;
       d.s = static_cast<double>(fd_->s) * m.length;
@@ -207,6 +201,16 @@ class FixedEngine final : public Engine {
       }
     }
     return d;
+  }
+
+  // The modes alone, in SI, into the shadow Data.
+  void shadow_modes() const {
+    const auto& fd = Of::frame(*fd_);
+    const auto& fr = fm_frame();
+    for (int j = 0; j < P; ++j) {
+      shadow_->z(j) = static_cast<double>(fd.z(j)) * fr.sq(j);
+      shadow_->z(P + j) = static_cast<double>(fd.z(P + j)) * fr.sv(j);
+    }
   }
 
   Counters counters() const {
@@ -226,7 +230,8 @@ class FixedEngine final : public Engine {
 
   // The floors' peaks, drifts and positive strain increments (loop.floor_peaks), in double.
   void floor_peaks() {
-    const DData& d = shadow();
+    shadow_modes();  // the floors need the modes only, not the particle's contact force
+    const DData& d = *shadow_;
     const Eigen::Matrix<double, N, 1> x = dm_->floor_x(d.z);
     peaks_ = peaks_.cwiseMax(x.cwiseAbs());
     for (int i = 0; i < N; ++i) drifts_(i) = std::fmax(drifts_(i), std::fabs(x(i) - (i ? x(i - 1) : 0.0)));
