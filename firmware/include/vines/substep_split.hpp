@@ -63,7 +63,7 @@ namespace detail {
 // right): 1/m*, the device floor's Markov parameters M_n (the floor's part
 // of the velocity entries of A^(n-1) bf; fm holds A^k bf for k < 4), and the
 // free relative acceleration toward the wall as a Taylor cubic from the
-// step's start (the particle's is -a_g, linear; the floor's from z's
+// step's start, in powers of t [s] (the particle's is -a_g, linear; the floor's from z's
 // derivatives).
 template <typename S, int N, typename Dev, int K>
 fixed::ContactCoupling<S, K> split_coupling(const Model<S, N, Dev>& m,
@@ -87,8 +87,8 @@ fixed::ContactCoupling<S, K> split_coupling(const Model<S, N, Dev>& m,
   const S sg = S(side);
   c.g[0] = sg * (-a0 - dev.dot(d2.matrix()));
   c.g[1] = sg * (-al - dev.dot(d3.matrix()));
-  c.g[2] = -sg * dev.dot(d4.matrix());
-  c.g[3] = -sg * dev.dot(d5.matrix());
+  c.g[2] = -sg * dev.dot(d4.matrix()) / S(2);
+  c.g[3] = -sg * dev.dot(d5.matrix()) / S(6);
   return c;
 }
 
@@ -225,10 +225,7 @@ void substep_split(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
   y0(1) = start.u;
   y0(2) = start.t;
   const int cap = kSplitCap * m.loop.split_steps;
-  // The largest free relative acceleration over the step, a bound from g(t)'s terms.
-  const S g_max =
-      std::fabs(c.g[0]) + h * (std::fabs(c.g[1]) + h * (std::fabs(c.g[2]) / S(2) + h * std::fabs(c.g[3]) / S(6)));
-  const fixed::ContactStep<S> scale = detail::split_scale(m, start.q, start.u, g_max);
+  const fixed::ContactStep<S> scale = detail::split_scale(m, start.q, start.u, fixed::g_bound(c));
   const fixed::ForcedContact<S, K> fc =
       fixed::forced_contact(dm.law, c, y0, scale.dw, scale.q_e, cap);
   S mu[K];

@@ -7,7 +7,7 @@
 //   t, h    T                       mu_k    m V tau^k
 //   e       m V^2                   w       T / D^{3/4}  (dt = 4 q^3 dw)
 //   1 / m*  1 / m                   M_{k+2} 1 / (m T tau^k)
-//   g_k     V / T^{k+1}  (g(t)'s Taylor coefficients)
+//   G_k     V / T        (g(t)'s Taylor coefficients in powers of t / tau)
 // The conversions run in double, where the coupling is built (the Markov
 // parameters are the model's constants); docs/fixed_point.md has the
 // formats and their ranges.
@@ -33,8 +33,8 @@ ContactCoupling<S, K, R> scaled_coupling(const ContactCoupling<double, K>& c, co
   out.inv_m_star = S(c.inv_m_star * u.m);
   double arm = 1.0;  // tau^k
   for (int k = 0; k < K; ++k, arm *= cu.tau) out.markov[k] = S(c.markov[k] * u.m * u.t * arm);
-  double tk = u.t;  // T^{k+1}
-  for (int k = 0; k < 4; ++k, tk *= u.t) out.g[k] = S(c.g[k] * tk / u.v);
+  double tk = u.t / u.v;  // tau^k T / V (c's g in powers of seconds)
+  for (int k = 0; k < 4; ++k, tk *= cu.tau) out.g[k] = S(c.g[k] * tk);
   out.h = S(c.h / u.t);
   out.r_scale = R(u.t / cu.tau);
   return out;

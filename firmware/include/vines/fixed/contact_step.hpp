@@ -5,7 +5,8 @@
 // (its Hertz part, c the law's elastic coefficient) reaches
 // q^10 + (5/4) (m*/c) u^2 at rest; g pressing from rest reaches
 // q^6 = (5/2) m* g / c; the contact's scale q_e is the larger (and at least
-// q_floor), and with the speed of an impact that deep,
+// q itself, which the energy's root is but for q^10 underflowing a fixed
+// format, and q_floor), and with the speed of an impact that deep,
 // v_e = sqrt(0.8 c / m*) q_e^5, dw = q_e / (n v_e) = dw_unit / q_e^4,
 // dw_unit = 1 / (n sqrt(0.8 c / m*)): the contact's own oscillation then
 // turns about 5.5 / n radians a step. dw is at most dw_max (a fixed-point
@@ -42,7 +43,8 @@ ContactStep<S> contact_step(S q, S u, S g, S m_star_c, S q_floor, S dw_unit, S d
   const S q2 = q * q, q10 = q2 * q2 * q2 * q2 * q2;
   const S by_energy = power(q10 + S(1.25) * m_star_c * u * u, 1, 10);
   const S by_force = power(S(2.5) * m_star_c * g, 1, 6);
-  const S q_e = numeric::max_of(numeric::max_of(by_energy, by_force), q_floor), q_e2 = q_e * q_e;
+  const S q_e = numeric::max_of(numeric::max_of(by_energy, by_force), numeric::max_of(q, q_floor));
+  const S q_e2 = q_e * q_e;
   const S q_e4 = numeric::max_of(q_e2 * q_e2, dw_unit / dw_max);
   return {dw_unit / q_e4, q_e};
 }

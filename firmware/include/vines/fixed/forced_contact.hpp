@@ -5,9 +5,12 @@
 // Markov parameters M_n give (the floor's impulse response is
 // sum_n M_n tau^n / n!): with I_k(t) = int_0^t F(s) (t - s)^k / k! ds,
 //   d'' = g(t) - F / m - M_1 F - M_2 I_0 - ... - M_{K+1} I_{K-1},
-// g(t) = g0 + g1 t + g2 t^2/2 + g3 t^3/6 the free relative acceleration
-// toward the wall over the step (a Taylor cubic from the state at the
-// step's start). Integrated in w (dt/dw = 4 q^3, q = d^{1/4}) by classic
+// g(t) the free relative acceleration toward the wall over the step, a
+// Taylor cubic from the state at the step's start, in powers of the
+// moments' time unit (x = t r_scale): g = G0 + G1 x + G2 x^2 + G3 x^3,
+// G_k = g^(k) tau^k / k! (in fixed point, where tau is the sensor step,
+// every G_k is then of the size of the acceleration's change over the
+// step, whatever the contact's own time unit). Integrated in w (dt/dw = 4 q^3, q = d^{1/4}) by classic
 // Runge-Kutta, with the energy lost and the force's moments about the
 // step's end, mu_k = int F(s) (h - s)^k / k! ds (k < K), which move the
 // frame (fixed/force_moments.hpp) and the particle, and from which the I_k
@@ -22,6 +25,9 @@
 // rate): r_scale = T / tau, mu_k in m V tau^k, M_{k+2} in 1 / (m T tau^k)
 // (fixed/contact_coupling.hpp).
 #pragma once
+
+#include <cmath>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -39,7 +45,7 @@ template <typename S, int K = 4, typename R = S>
 struct ContactCoupling {
   S inv_m_star = S(0);  // 1 / m + M_1 (M_1 = 1 / m_f, the floor's mass)
   S markov[K] = {};     // M_2 .. M_{K+1}
-  S g[4] = {};          // g(t)'s Taylor coefficients
+  S g[4] = {};          // g(t)'s Taylor coefficients in powers of t r_scale (G_k above)
   S h = S(0);           // the step's end
   R r_scale = R(1);     // the moments' lever arm (h - t) in its own unit: (h - t) r_scale
 };
@@ -59,6 +65,16 @@ struct ForcedContact {
 
 namespace detail {
 
+// x / j: Fixed's one 32-bit division (numeric/fixed.hpp), a floating
+// point's own.
+template <typename S>
+S over(S x, int j) {
+  if constexpr (std::is_floating_point_v<S>)
+    return x / static_cast<S>(j);
+  else
+    return x / j;
+}
+
 // The floor's response term sum_k M_{k+2} I_k(t), from the moments about
 // the step's end (I_k(t) = sum_{i <= k} mu_i (t - h)^{k-i} / (k-i)!),
 // gathered per moment: sum_i mu_i sum_{j < K - i} M_{i+j+2} x^j / j!,
@@ -69,7 +85,7 @@ S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y)
   S sum = S(0);
   for (int i = 0; i < K; ++i) {
     S poly = c.markov[K - 1];
-    for (int j = K - 1 - i; j > 0; --j) poly = c.markov[i + j - 1] + x * poly / j;
+    for (int j = K - 1 - i; j > 0; --j) poly = c.markov[i + j - 1] + over(x * poly, j);
     sum += poly * y(3 + i);
   }
   return sum;
@@ -80,7 +96,8 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& 
   const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q;
   const contact::Force<S> f = law.regular(q, u);
   const S force = f.total();
-  const S g = c.g[0] + t * (c.g[1] + t * (c.g[2] / 2 + t * c.g[3] / 6));
+  const S x = t * c.r_scale;
+  const S g = c.g[0] + x * (c.g[1] + x * (c.g[2] + x * c.g[3]));
   ContactState<S, K> d;
   d(0) = u;
   d(1) = j * (g - floor_response(c, y) - force * c.inv_m_star);
@@ -90,13 +107,21 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& 
   const S r = (c.h - t) * c.r_scale;
   for (int k = 0; k < K; ++k) {
     d(3 + k) = term;
-    term = term * r / (k + 1);
+    term = over(term * r, k + 1);
   }
   d(K + 3) = j * f.dissipative * u;
   return d;
 }
 
 }  // namespace detail
+
+// A bound on |g(t)| over the step: sum_k |G_k| (h r_scale)^k.
+template <typename S, int K, typename R>
+S g_bound(const ContactCoupling<S, K, R>& c) {
+  using std::abs;
+  const S span = c.h * c.r_scale;
+  return abs(c.g[0]) + span * (abs(c.g[1]) + span * (abs(c.g[2]) + span * abs(c.g[3])));
+}
 
 // Near a contact's ends (q small against its scale q_ref) the path is
 // nearly q = q0 + u w and the force's terms are tiny: a step there may be

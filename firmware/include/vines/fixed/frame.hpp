@@ -87,12 +87,16 @@ struct FixedFrameData {
   std::uint32_t steps = 0, peak_step = 0;  // steps taken; the one that ended at the peak
 };
 
-// sum_j v_j g_j 2^shift.
+// (x0 g0 + sum_j v_j g_j) 2^shift, summed 64 bits wide and saturated once
+// (numeric::wide_product): the modes' terms of a floor's motion may cancel
+// one another, and the ground's term x0 g0 theirs.
 template <typename Q, std::size_t P, typename Z>
-Q gain_dot(const std::array<numeric::Gain, P>& g, const Z& v, int shift = 0) {
-  Q sum = Q(0);
-  for (std::size_t j = 0; j < P; ++j) sum += v(static_cast<int>(j)) * g[j].shifted(shift);
-  return sum;
+Q gain_dot(const std::array<numeric::Gain, P>& g, const Z& v, int shift = 0, Q x0 = Q(0),
+           numeric::Gain g0 = numeric::Gain()) {
+  using W = numeric::Wide<Q::kFractionBits>;
+  W sum = W::from_raw(wide_product(x0, g0.shifted(shift)));
+  for (std::size_t j = 0; j < P; ++j) sum += W::from_raw(wide_product(v(static_cast<int>(j)), g[j].shifted(shift)));
+  return sum.template to_fixed<Q::kFractionBits>();
 }
 
 // At rest, the first sample a0 [sa].

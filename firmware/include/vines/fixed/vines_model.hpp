@@ -68,10 +68,12 @@ struct FixedVines {
   // + (a0 g0, (a1 - a0) g1 for k = 0, 1).
   VecP dk, dc;
   GainP dg0, dg1;
-  // g(t)'s Taylor coefficients in the contact's units: g_k = -(ground term)
-  // - sum_j gd[k]_j D_{k+2,j}; ground terms a0 ga0 (k = 0), (a1 - a0) ga1 (k = 1).
+  // g(t)'s Taylor coefficients in powers of t / h, in the contact's units
+  // (fixed/forced_contact.hpp): G_k = -(ground term) - sum_j gd[k]_j
+  // D_{k+2,j}; ground terms a0 ga (k = 0), (a1 - a0) ga (k = 1). Shrunk n
+  // times, every one scales by 2^6n.
   GainP gd[4];
-  G ga0, ga1;
+  G ga;
   // The coupling's constants (g is the step's) and the law, in the
   // contact's units shrunk n times.
   ContactCoupling<Q, K, G> coupling[kShrinks];
@@ -126,12 +128,11 @@ FixedVines<F, Model<double, N, Dev>::kP, Law::template Kernel, K> build_fixed_vi
     o.dc(j) = Q(live ? l.ac(j) / w(j) : 0.0);
     o.dg0[j] = G(live ? l.bgv(j) * sc.sa / (sq(j) * w(j) * w(j)) : 0.0);
     o.dg1[j] = G(live ? l.bgv(j) * sc.sa / (sq(j) * w(j) * w(j) * w(j) * h) : 0.0);
-    double wt = w(j) * u.t;  // (w_j T)^(k+2)
-    wt *= wt;
-    for (int k = 0; k < 4; ++k, wt *= w(j) * u.t) o.gd[k][j] = G(live ? m.rows.dev(j) * sq(j) * wt / u.d : 0.0);
+    double wt = w(j) * w(j) * u.t * u.t;  // w_j^(k+2) T^2 h^k / k!
+    for (int k = 0; k < 4; ++k, wt *= w(j) * h / (k + 1))
+      o.gd[k][j] = G(live ? m.rows.dev(j) * sq(j) * wt / u.d : 0.0);
   }
-  o.ga0 = G(sc.sa * u.t * u.t / u.d);
-  o.ga1 = G(sc.sa * u.t * u.t * u.t / (h * u.d));
+  o.ga = G(sc.sa * u.t * u.t / u.d);
   // The coupling's constants: split_coupling's on a state at rest.
   const auto fm = force_moments<K>(l);
   const ContactCoupling<double, K> c_si =

@@ -129,33 +129,41 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       D5(j) = m.dk(j) * D3(j) + m.dc(j) * D4(j);
     }
     // The contact's units: shrunk n times for a shallow contact (its scale
-    // q_e below 0.4), so that the overlap's equation runs at O(1) values:
+    // q_e below 0.4, from its start and the largest pressing of the cubic
+    // over the step), so that the overlap's equation runs at O(1) values:
     // q_e ends in [0.4, 0.8), leaving room for a contact deeper than the
     // step's start predicts (at q = 1 the overlap's rate du/dw = 4 q^3 F m /
-    // m* reaches Q3.28's 8 in an elastic impact at V).
+    // m* reaches Q3.28's 8 in an elastic impact at V). The cubic's terms are
+    // summed 64 bits wide in each unit (the ground's term against the
+    // modes'), not shifted from the first: a riding contact's are small
+    // differences of large ones.
+    auto taylor = [&](ContactCoupling<Q, K, numeric::Gain>& cc, int shift) {
+      cc.g[0] = -(sg * gain_dot<Q>(m.gd[0], D2, shift, a0, m.ga));
+      cc.g[1] = -(sg * gain_dot<Q>(m.gd[1], D3, shift, da, m.ga));
+      cc.g[2] = -(sg * gain_dot<Q>(m.gd[2], D4, shift));
+      cc.g[3] = -(sg * gain_dot<Q>(m.gd[3], D5, shift));
+    };
+    ContactCoupling<Q, K, numeric::Gain> c = m.coupling[0];
+    taylor(c, 0);
     int n = 0;
     {
       const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
-      const Q g_base = abs(a0 * m.ga0) + abs(gain_dot<Q>(m.gd[0], D2));
-      Q q_e = contact_step(q0, u0, g_base, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
+      Q q_e = contact_step(q0, u0, g_bound(c), m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
       while (n + 1 < M::kShrinks && q_e < Q(0.4)) {
         q_e = q_e * Q(2);
         ++n;
       }
     }
-    ContactCoupling<Q, K, numeric::Gain> c = m.coupling[n];
-    c.g[0] = sg * (-(a0 * m.ga0.shifted(6 * n)) - gain_dot<Q>(m.gd[0], D2, 6 * n));
-    c.g[1] = sg * (-(da * m.ga1.shifted(7 * n)) - gain_dot<Q>(m.gd[1], D3, 7 * n));
-    c.g[2] = -(sg * gain_dot<Q>(m.gd[2], D4, 8 * n));
-    c.g[3] = -(sg * gain_dot<Q>(m.gd[3], D5, 9 * n));
-    const Q g_max =
-        abs(c.g[0]) + c.h * (abs(c.g[1]) + c.h * (abs(c.g[2]) / 2 + c.h * abs(c.g[3]) / 6));
+    if (n > 0) {
+      c = m.coupling[n];
+      taylor(c, 6 * n);
+    }
     ContactState<Q, K> y0;
     y0.setConstant(Q(0));
     y0(0) = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap.shifted(4 * n)));
     y0(1) = u_src * u_gain.shifted(5 * n);
     y0(2) = theta * c.h;
-    const ContactStep<Q> rule = contact_step(y0(0), y0(1), g_max, m.m_star_c, m.q_floor, m.dw_unit, m.dw_max);
+    const ContactStep<Q> rule = contact_step(y0(0), y0(1), g_bound(c), m.m_star_c, m.q_floor, m.dw_unit, m.dw_max);
     const ForcedContact<Q, K> fc = forced_contact(m.law[n], c, y0, rule.dw, rule.q_e, m.max_steps);
     if (theta > Q(0) || d.side == 0) {
       ++d.events;

@@ -45,20 +45,30 @@ class Gain {
   // This factor times 2^n, exactly.
   Gain shifted(int n) const { return from_parts(mant_, exp_ + n); }
 
-  // x g: (raw m) 2^(e - 30), rounded to nearest.
+  // x g in x's format but 64 bits wide, rounded to nearest and not yet
+  // saturated (a product beyond +-2^62 is held there, which saturates any
+  // Fixed): a sum of such products saturates once, at its end, so terms
+  // that cancel (a mode's part of a floor's motion against the others')
+  // may each pass the format's range.
   template <int F>
-  friend Fixed<F> operator*(Fixed<F> x, Gain g) {
+  friend std::int64_t wide_product(Fixed<F> x, Gain g) {
+    constexpr std::int64_t kHeld = std::int64_t{1} << 62;
     const std::int64_t p = std::int64_t{x.raw()} * g.mant_;
     const int shift = 30 - g.exp_;
     if (shift <= 0) {
-      if (p == 0) return Fixed<F>(0);
-      if (shift < -32) return Fixed<F>::saturated(p > 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62));
+      if (p == 0) return 0;
+      if (shift < -32) return p > 0 ? kHeld : -kHeld;
       const std::int64_t limit = std::int64_t{1} << (62 + shift);  // |p| below it: no overflow
-      if (p >= limit || p <= -limit) return Fixed<F>::saturated(p > 0 ? std::int64_t{1} << 62 : -(std::int64_t{1} << 62));
-      return Fixed<F>::saturated(p * (std::int64_t{1} << -shift));
+      if (p >= limit || p <= -limit) return p > 0 ? kHeld : -kHeld;
+      return p * (std::int64_t{1} << -shift);
     }
-    if (shift >= 63) return Fixed<F>(0);
-    return Fixed<F>::saturated((p + (std::int64_t{1} << (shift - 1))) >> shift);
+    if (shift >= 63) return 0;
+    return (p + (std::int64_t{1} << (shift - 1))) >> shift;
+  }
+  // x g: (raw m) 2^(e - 30), rounded to nearest, saturated.
+  template <int F>
+  friend Fixed<F> operator*(Fixed<F> x, Gain g) {
+    return Fixed<F>::saturated(wide_product(x, g));
   }
   template <int F>
   friend Fixed<F> operator*(Gain g, Fixed<F> x) {
