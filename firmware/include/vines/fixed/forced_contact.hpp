@@ -66,9 +66,10 @@ struct ForcedContact {
 namespace detail {
 
 // x / j: Fixed's one 32-bit division (numeric/fixed.hpp), a floating
-// point's own.
+// point's own; none for j = 1 (the series' first terms).
 template <typename S>
 S over(S x, int j) {
+  if (j == 1) return x;
   if constexpr (std::is_floating_point_v<S>)
     return x / static_cast<S>(j);
   else
@@ -161,8 +162,10 @@ ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R
       const State d = rate(y);  // d/dw at the guess
       const S miss = contact_ends ? y(0) : y(2) - c.h, slope = contact_ends ? d(0) : d(2);
       if (slope == S(0)) break;
-      theta = theta - miss / (slope * step);
-      theta = theta < S(0) ? S(0) : (theta > S(1) ? S(1) : theta);  // the end lies in this step
+      S next_theta = theta - miss / (slope * step);
+      next_theta = next_theta < S(0) ? S(0) : (next_theta > S(1) ? S(1) : next_theta);  // the end lies in this step
+      if (next_theta == theta) break;  // converged: the step would be the same
+      theta = next_theta;
       y = numeric::rk4_step(rate, out.y, theta * step);
     }
     out.y = y;

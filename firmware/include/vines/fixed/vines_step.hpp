@@ -100,7 +100,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
       const numeric::Cubic<Q> c{g0 - m.event_tol, Q(sg) * rd0 * m.fly_v, g1 - m.event_tol, Q(sg) * rd1 * m.fly_v,
                                 Q(1)};
       if (!(c.max_value() > Q(0))) continue;
-      const Q th = c.first_upcrossing(24);
+      const Q th = numeric::PowerCubic<Q>(c).first_upcrossing(24);
       if (side == 0 || th < theta) {
         side = sg;
         theta = th;

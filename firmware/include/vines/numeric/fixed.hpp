@@ -56,8 +56,18 @@ class Fixed {
   explicit operator double() const { return static_cast<double>(raw_) / kOne; }
   explicit operator float() const { return static_cast<float>(static_cast<double>(*this)); }
 
-  friend Fixed operator+(Fixed a, Fixed b) { return from_raw(saturate(std::int64_t{a.raw_} + b.raw_)); }
-  friend Fixed operator-(Fixed a, Fixed b) { return from_raw(saturate(std::int64_t{a.raw_} - b.raw_)); }
+  // Sums in 32 bits with the overflow flag (one add and a branch on a
+  // Cortex-M), the saturated value the 64-bit sum would give.
+  friend Fixed operator+(Fixed a, Fixed b) {
+    Raw r;
+    if (__builtin_add_overflow(a.raw_, b.raw_, &r)) return from_raw(overflowed(b.raw_ > 0));
+    return from_raw(r);
+  }
+  friend Fixed operator-(Fixed a, Fixed b) {
+    Raw r;
+    if (__builtin_sub_overflow(a.raw_, b.raw_, &r)) return from_raw(overflowed(b.raw_ < 0));
+    return from_raw(r);
+  }
   friend Fixed operator-(Fixed a) { return from_raw(saturate(-std::int64_t{a.raw_})); }
   friend Fixed operator*(Fixed a, Fixed b) {
     const std::int64_t p = std::int64_t{a.raw_} * b.raw_ + (std::int64_t{1} << (F - 1));
@@ -92,16 +102,14 @@ class Fixed {
   static Fixed epsilon() { return from_raw(1); }
 
  private:
+  static Raw overflowed(bool up) {
+    ++fixed_saturations();
+    return up ? std::numeric_limits<Raw>::max() : std::numeric_limits<Raw>::min();
+  }
   static Raw saturate(std::int64_t v) {
-    if (v > std::numeric_limits<Raw>::max()) {
-      ++fixed_saturations();
-      return std::numeric_limits<Raw>::max();
-    }
-    if (v < std::numeric_limits<Raw>::min()) {
-      ++fixed_saturations();
-      return std::numeric_limits<Raw>::min();
-    }
-    return static_cast<Raw>(v);
+    const Raw r = static_cast<Raw>(v);
+    if (r == v) return r;  // in range (one compare of the high word on a 32-bit core)
+    return overflowed(v > 0);
   }
   static Raw from_double(double v) {
     if (!(v == v)) return 0;

@@ -86,16 +86,40 @@ bool grid_upcrossing(const Curve& c, S f0, S* lo, S* hi) {
   return false;
 }
 
-template <typename S>
-S Cubic<S>::first_upcrossing(int halvings) const {
+// The first theta in (0, 1] where the curve c rises through zero (f0 =
+// its value at 0 <= 0): the grid's cell, then `halvings` bisections; 1 if
+// none.
+template <typename Curve, typename S>
+S upcrossing(const Curve& c, S f0, int halvings) {
   S a, b;
-  if (!grid_upcrossing(*this, y0, &a, &b)) return S(1);
+  if (!grid_upcrossing(c, f0, &a, &b)) return S(1);
   for (int it = 0; it < halvings; ++it) {
     const S m = S(0.5) * (a + b);
-    if (value(m) > S(0)) b = m; else a = m;
+    if (c.value(m) > S(0)) b = m; else a = m;
   }
   return b;
 }
+
+template <typename S>
+S Cubic<S>::first_upcrossing(int halvings) const {
+  return upcrossing(*this, y0, halvings);
+}
+
+// The same cubic in powers of theta, c0 + c1 th + c2 th^2 + c3 th^3: three
+// products a value against the Hermite form's twenty (the fixed-point
+// step's 40 values of a contact start on a Cortex-M3).
+template <typename S>
+struct PowerCubic {
+  S c0, c1, c2, c3;
+
+  explicit PowerCubic(const Cubic<S>& c)
+      : c0(c.y0),
+        c1(c.d0),
+        c2(S(3) * (c.y1 - c.y0) - S(2) * c.d0 - c.d1),
+        c3(S(2) * (c.y0 - c.y1) + c.d0 + c.d1) {}
+  S value(S th) const { return c0 + th * (c1 + th * (c2 + th * c3)); }
+  S first_upcrossing(int halvings) const { return upcrossing(*this, c0, halvings); }
+};
 
 // The cubic Hermite interpolant of a vector function on [0, h] (values y0,
 // y1 and derivatives f0, f1 at the ends) at theta = t / h (also outside [0, 1]).
