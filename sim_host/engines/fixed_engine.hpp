@@ -43,11 +43,11 @@ struct FixedOf {
 
 template <int N, ContactLaw L>
 struct FixedOf<N, VinesDevice<L>> {
-  using M = decltype(fixed::build_fixed_vines<kFixedBits, kSplitMoments, LawOf<L>>(
+  using M = decltype(fixed::build_fixed_vines<kFixedBits, fixed::kFixedMoments, LawOf<L>>(
       std::declval<const Model<double, N, VinesDevice<L>>&>(), fixed::FixedScales{}));
   using D = fixed::FixedVinesData<M>;
   static M build(const Model<double, N, VinesDevice<L>>& m, const FixedParams& f) {
-    return fixed::build_fixed_vines<kFixedBits, kSplitMoments, LawOf<L>>(
+    return fixed::build_fixed_vines<kFixedBits, fixed::kFixedMoments, LawOf<L>>(
         m, fixed::FixedScales{f.accel_mps2, f.amplification, f.contact_speed_mps});
   }
   static const typename M::Frame& frame(const M& m) { return m.frame; }

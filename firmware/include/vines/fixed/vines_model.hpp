@@ -35,6 +35,13 @@
 
 namespace vines::fixed {
 
+// The force's moments the fixed-point step carries: four, not the double
+// split's six (substep_split.hpp): the two more change El Centro's peaks by
+// 1e-7 and E_r by 0.07 points in Q3.28 (tests/test_fixed_vines.cpp), below
+// its resolution at the record's scale, and cost a third of each
+// Runge-Kutta step on a Cortex-M3 (docs/fixed_point.md).
+inline constexpr int kFixedMoments = 4;
+
 // The scales a fixed-point model is built for: sa bounds the record's
 // ground acceleration [m/s^2], amp the modes' dynamic amplification, V the
 // contacts' approach speed [m/s].
