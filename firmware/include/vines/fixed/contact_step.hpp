@@ -37,6 +37,14 @@ struct ContactStep {
   S dw, q_e;
 };
 
+// The step of a contact of depth scale q_e.
+template <typename S>
+ContactStep<S> step_of_scale(S q_e, S dw_unit, S dw_max) {
+  const S q_e2 = q_e * q_e;
+  const S q_e4 = numeric::max_of(q_e2 * q_e2, dw_unit / dw_max);
+  return {dw_unit / q_e4, q_e};
+}
+
 // m_star_c = m* / c; g >= 0.
 template <typename S>
 ContactStep<S> contact_step(S q, S u, S g, S m_star_c, S q_floor, S dw_unit, S dw_max) {
@@ -44,9 +52,7 @@ ContactStep<S> contact_step(S q, S u, S g, S m_star_c, S q_floor, S dw_unit, S d
   const S by_energy = power(q10 + S(1.25) * m_star_c * u * u, 1, 10);
   const S by_force = power(S(2.5) * m_star_c * g, 1, 6);
   const S q_e = numeric::max_of(numeric::max_of(by_energy, by_force), numeric::max_of(q, q_floor));
-  const S q_e2 = q_e * q_e;
-  const S q_e4 = numeric::max_of(q_e2 * q_e2, dw_unit / dw_max);
-  return {dw_unit / q_e4, q_e};
+  return step_of_scale(q_e, dw_unit, dw_max);
 }
 
 }  // namespace vines::fixed

@@ -79,10 +79,10 @@ S over(S x, int j) {
 // The floor's response term sum_k M_{k+2} I_k(t), from the moments about
 // the step's end (I_k(t) = sum_{i <= k} mu_i (t - h)^{k-i} / (k-i)!),
 // gathered per moment: sum_i mu_i sum_{j < K - i} M_{i+j+2} x^j / j!,
-// x = (t - h) r_scale.
+// x = (t - h) r_scale = -r.
 template <typename S, int K, typename R>
-S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y) {
-  const S x = (y(2) - c.h) * c.r_scale;
+S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y, S r) {
+  const S x = -r;
   S sum = S(0);
   for (int i = 0; i < K; ++i) {
     S poly = c.markov[K - 1];
@@ -92,20 +92,22 @@ S floor_response(const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y)
   return sum;
 }
 
+// The rates d/dw times `scale` (1: the rates; a step dw: its increments,
+// folded into dt/dw, one product); span = h r_scale (the lever arm at t = 0).
 template <typename S, int K, typename R, typename Law>
-ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y) {
-  const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q;
+ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y,
+                                S span, S scale = S(1)) {
+  const S q = y(0), u = y(1), t = y(2), j = S(4) * q * q * q * scale;
   const contact::Force<S> f = law.regular(q, u);
   const S force = f.total();
-  const S x = t * c.r_scale;
+  const S x = t * c.r_scale, r = span - x;  // t and h - t in the lever arm's unit
   const S g = c.g[0] + x * (c.g[1] + x * (c.g[2] + x * c.g[3]));
   ContactState<S, K> d;
-  d(0) = u;
-  d(1) = j * (g - floor_response(c, y) - force * c.inv_m_star);
+  d(0) = u * scale;
+  d(1) = j * (g - floor_response(c, y, r) - force * c.inv_m_star);
   d(2) = j;
   // mu_k' = F (h - t)^k / k!, each term from the last.
   S term = j * force;
-  const S r = (c.h - t) * c.r_scale;
   for (int k = 0; k < K; ++k) {
     d(3 + k) = term;
     term = over(term * r, k + 1);
@@ -129,6 +131,14 @@ S g_bound(const ContactCoupling<S, K, R>& c) {
 // up to this many times dw (dw q_ref / (2 q)).
 inline constexpr int kMaxStretch = 4;
 
+// Newton steps placing a step's end on the contact's end or the sensor
+// step's end, after the secant guess: three in floating point; in fixed
+// point one (after it, theta moves by at most a few of Q3.28's units, while
+// each further step re-takes a Runge-Kutta step: on a Cortex-M3 the worst
+// sensor step's largest part).
+template <typename S>
+inline constexpr int kNewtonSteps = std::is_floating_point_v<S> ? 3 : 1;
+
 // From y0 (q > 0, or q = 0 with u > 0 at first touch) to the contact's end
 // or the step's end, whichever comes first, in steps of dw in w (stretched
 // near the contact's ends by q_ref, see kMaxStretch; q_ref = 0: none), at
@@ -137,7 +147,16 @@ template <typename S, int K, typename R, typename Law>
 ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R>& c, const ContactState<S, K>& y0,
                                    S dw, S q_ref, int max_steps) {
   using State = ContactState<S, K>;
-  auto rate = [&](const State& y) { return detail::contact_rate(law, c, y); };
+  const S span = c.h * c.r_scale;
+  auto rate = [&](const State& y) { return detail::contact_rate(law, c, y, span); };
+  // Classic Runge-Kutta; in fixed point on the rates' increments (no
+  // weight products: the stages halve, the sum divides by 6 once).
+  auto advance = [&](const State& y, S h) {
+    if constexpr (std::is_floating_point_v<S>)
+      return numeric::rk4_step(rate, y, h);
+    else
+      return numeric::rk4_increments([&](const State& v) { return detail::contact_rate(law, c, v, span, h); }, y);
+  };
   const S reach = q_ref / 2, most = S(kMaxStretch) * dw;
   ForcedContact<S, K> out;
   out.y = y0;
@@ -145,7 +164,7 @@ ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R
   for (; out.steps < max_steps; ++out.steps) {
     const S q = out.y(0);
     const S step = q >= reach ? dw : (q * S(kMaxStretch) <= reach ? most : dw * reach / q);
-    const State next = numeric::rk4_step(rate, out.y, step);
+    const State next = advance(out.y, step);
     const bool ends = next(0) < S(0), late = next(2) > c.h;
     if (!ends && !late) {
       out.y = next;
@@ -157,8 +176,8 @@ ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R
     S theta_h = late ? (c.h - out.y(2)) / (next(2) - out.y(2)) : S(2);
     const bool contact_ends = theta_end < theta_h;
     S theta = contact_ends ? theta_end : theta_h;
-    State y = numeric::rk4_step(rate, out.y, theta * step);
-    for (int it = 0; it < 3; ++it) {
+    State y = advance(out.y, theta * step);
+    for (int it = 0; it < kNewtonSteps<S>; ++it) {
       const State d = rate(y);  // d/dw at the guess
       const S miss = contact_ends ? y(0) : y(2) - c.h, slope = contact_ends ? d(0) : d(2);
       if (slope == S(0)) break;
@@ -166,7 +185,7 @@ ForcedContact<S, K> forced_contact(const Law& law, const ContactCoupling<S, K, R
       next_theta = next_theta < S(0) ? S(0) : (next_theta > S(1) ? S(1) : next_theta);  // the end lies in this step
       if (next_theta == theta) break;  // converged: the step would be the same
       theta = next_theta;
-      y = numeric::rk4_step(rate, out.y, theta * step);
+      y = advance(out.y, theta * step);
     }
     out.y = y;
     if (y(0) > out.q_max) out.q_max = y(0);

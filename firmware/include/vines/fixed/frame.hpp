@@ -79,7 +79,7 @@ FixedFrame<F, Model<double, N, Dev>::kP> build_fixed_frame(const Model<double, N
 template <typename Fr>
 struct FixedFrameData {
   using Q = typename Fr::Q;
-  typename Fr::VecX z;    // the modes
+  typename Fr::VecX z = Fr::VecX::Constant(Q(0));  // the modes
   Q a_prev = Q(0);        // the last sample, in sa
   Q peak_top = Q(0);      // largest |x_top| at a step's end [Lt]
   Q peak_top_velocity = Q(0);  // largest |v_top| at a step's end [Vt]
@@ -102,9 +102,7 @@ Q gain_dot(const std::array<numeric::Gain, P>& g, const Z& v, int shift = 0, Q x
 // At rest, the first sample a0 [sa].
 template <typename Fr>
 void fixed_frame_init(const Fr& /*fr*/, FixedFrameData<Fr>& d, typename Fr::Q a0) {
-  using Q = typename Fr::Q;
   d = FixedFrameData<Fr>{};
-  d.z.setConstant(Q(0));
   d.a_prev = a0;
 }
 

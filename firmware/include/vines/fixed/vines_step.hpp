@@ -145,14 +145,14 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     };
     ContactCoupling<Q, K, numeric::Gain> c = m.coupling[0];
     taylor(c, 0);
+    // The scale shrinks with the units, by 2^n exactly (the Hertz force's
+    // similarity): the Runge-Kutta step follows from it.
     int n = 0;
-    {
-      const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
-      Q q_e = contact_step(q0, u0, g_bound(c), m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
-      while (n + 1 < M::kShrinks && q_e < Q(0.4)) {
-        q_e = q_e * Q(2);
-        ++n;
-      }
+    const Q q0 = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap)), u0 = u_src * u_gain;
+    Q q_e = contact_step(q0, u0, g_bound(c), m.m_star_c, m.q_floor, m.dw_unit, m.dw_max).q_e;
+    while (n + 1 < M::kShrinks && q_e < Q(0.4)) {
+      q_e = q_e * Q(2);
+      ++n;
     }
     if (n > 0) {
       c = m.coupling[n];
@@ -163,7 +163,7 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     y0(0) = numeric::sqrt(numeric::sqrt(overlap0 * m.to_overlap.shifted(4 * n)));
     y0(1) = u_src * u_gain.shifted(5 * n);
     y0(2) = theta * c.h;
-    const ContactStep<Q> rule = contact_step(y0(0), y0(1), g_bound(c), m.m_star_c, m.q_floor, m.dw_unit, m.dw_max);
+    const ContactStep<Q> rule = step_of_scale(q_e, m.dw_unit, m.dw_max);
     const ForcedContact<Q, K> fc = forced_contact(m.law[n], c, y0, rule.dw, rule.q_e, m.max_steps);
     if (theta > Q(0) || d.side == 0) {
       ++d.events;
@@ -175,14 +175,21 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     if (fc.capped) ++d.capped;
 
     // 4. The step's end.
+    // Each mode takes its moments' terms summed 64 bits wide, rounded and
+    // saturated once.
     const int back = -5 * n;  // the moments' unit m V 2^-5n tau^k
-    for (int k = 0; k < K; ++k) {
-      const Q mu = sg * fc.y(3 + k);
-      for (int j = 0; j < P; ++j) {
-        const std::size_t i = static_cast<std::size_t>(j);
-        z(j) += mu * m.mom_x[k][i].shifted(back);
-        z(P + j) += mu * m.mom_v[k][i].shifted(back);
+    using W = numeric::Wide<Q::kFractionBits>;
+    Q mu[K];
+    for (int k = 0; k < K; ++k) mu[k] = sg * fc.y(3 + k);
+    for (int j = 0; j < P; ++j) {
+      const std::size_t i = static_cast<std::size_t>(j);
+      W dx = W::from_raw(0), dv = W::from_raw(0);
+      for (int k = 0; k < K; ++k) {
+        dx += W::from_raw(wide_product(mu[k], m.mom_x[k][i].shifted(back)));
+        dv += W::from_raw(wide_product(mu[k], m.mom_v[k][i].shifted(back)));
       }
+      z(j) += dx.template to_fixed<Q::kFractionBits>();
+      z(P + j) += dv.template to_fixed<Q::kFractionBits>();
     }
     sd -= sg * fc.y(3) * m.mu_v.shifted(back);
     s -= sg * fc.y(4) * m.mu_x.shifted(back);

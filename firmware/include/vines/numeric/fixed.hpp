@@ -85,6 +85,13 @@ class Fixed {
     if (b == -1) return -a;
     return from_raw(static_cast<Raw>(a.raw_ / b));
   }
+  // By a positive integer, rounded to nearest, ties to even: the unbiased
+  // sibling of the division above, for sums that repeat it.
+  friend Fixed div_rounded(Fixed a, int b) {
+    const Raw q = a.raw_ / b, r = a.raw_ - q * b;  // q truncated, r of a's sign
+    const Raw twice = r < 0 ? -2 * r : 2 * r, away = r < 0 ? -1 : 1;
+    return from_raw(twice > b || (twice == b && (q & 1)) ? q + away : q);
+  }
   Fixed& operator+=(Fixed b) { return *this = *this + b; }
   Fixed& operator-=(Fixed b) { return *this = *this - b; }
   Fixed& operator*=(Fixed b) { return *this = *this * b; }

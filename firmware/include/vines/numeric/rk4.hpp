@@ -17,4 +17,23 @@ Vec rk4_step(F&& f, const Vec& y, S h) {
   return y + (k1 * sixth + k2 * third + k3 * third + k4 * sixth);
 }
 
+// The same step from increments, for a fixed-point scalar (whose products
+// cost): k(y) returns h y' (the step folded into the rates), so the stages
+// take halves and the sum one division by 6, each rounded to nearest
+// (div_rounded: a truncating division would bias every step the same way),
+// and no weight products. The increments are small: their sum stays in range.
+template <typename Vec, typename K>
+Vec rk4_increments(K&& k, const Vec& y) {
+  const Vec k1 = k(y);
+  Vec s;
+  for (int i = 0; i < y.size(); ++i) s(i) = y(i) + div_rounded(k1(i), 2);
+  const Vec k2 = k(s);
+  for (int i = 0; i < y.size(); ++i) s(i) = y(i) + div_rounded(k2(i), 2);
+  const Vec k3 = k(s);
+  for (int i = 0; i < y.size(); ++i) s(i) = y(i) + k3(i);
+  const Vec k4 = k(s);
+  for (int i = 0; i < y.size(); ++i) s(i) = y(i) + div_rounded(k1(i) + k2(i) + k2(i) + k3(i) + k3(i) + k4(i), 6);
+  return s;
+}
+
 }  // namespace vines::numeric
