@@ -49,6 +49,29 @@ TEST(Fixed, DivisionByAnIntegerIsTheFixedDivision) {
   EXPECT_EQ(both, 2u);
 }
 
+// The rounded division (the contact's Runge-Kutta sums, numeric/rk4.hpp)
+// is the nearest integer to raw / d, ties to even, against long double:
+// random values, the range's edges and every tie.
+TEST(Fixed, RoundedDivisionIsTheNearestTiesToEven) {
+  std::mt19937 rng(35);
+  std::uniform_int_distribution<std::int32_t> raw(std::numeric_limits<std::int32_t>::min(),
+                                                  std::numeric_limits<std::int32_t>::max());
+  std::vector<std::int32_t> values{std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::min(),
+                                   0, 1, -1, 2, -2, 3, -3, 5, -5, 9, -9, 15, -15};
+  for (int i = 0; i < 100000; ++i) values.push_back(raw(rng));
+  fixed_saturations() = 0;
+  int ties = 0;
+  for (const std::int32_t v : values)
+    for (int d : {2, 3, 6}) {
+      const long double exact = static_cast<long double>(v) / d;
+      ties += 2 * (v % d) == d || 2 * (v % d) == -d;
+      const auto expected = static_cast<std::int32_t>(std::nearbyintl(exact));  // the default mode: ties to even
+      ASSERT_EQ(div_rounded(Q::from_raw(v), d).raw(), expected) << v << " / " << d;
+    }
+  EXPECT_GT(ties, 50000);
+  EXPECT_EQ(fixed_saturations(), 0u);
+}
+
 TEST(Fixed, EigenArraysTakeIt) {
   Eigen::Matrix<Q, 3, 1> a, b;
   a << Q(1.0), Q(-2.0), Q(0.5);
