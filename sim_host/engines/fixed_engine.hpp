@@ -1,9 +1,16 @@
-// The Engine of the fixed-point firmware (scene loop.scalar = "fixed"): the
-// Q3.28 step of fixed/frame.hpp (no device) or fixed/vines_step.hpp (a VI
-// NES, the split contact scheme) on a model built, in double, from the
-// double one and the scene's loop.fixed_* scales. Outputs are read back in
-// double here, on the host: the step itself has no floating point. Every
-// saturation of a run is counted (RunTotals::fixed_saturations).
+// The Engine of the fixed-point firmware (scene loop.scalar = "fixed"): a
+// device's node model (fixed/node_model.hpp: the Q3.28 step of
+// fixed/frame.hpp (no device), fixed/tmd.hpp (a TMD: the dense step in real
+// block-diagonal form) or fixed/vines_step.hpp (a VI NES, the split contact
+// scheme), its readout and initial conditions) built, in double, from the
+// double model and the scene's loop.fixed_* scales; the same block a
+// fixed-point board loads as its model image. The step itself has no
+// floating point. The floors, the top floor's acceleration, E_e and the
+// particle are read as the board reads them (fixed/readout.hpp), so its
+// telemetry equals this engine's bit for bit; the rest (velocities, the
+// TMD, the other floors' accelerations, the strain) is read back in double
+// on a shadow of the double model's data. Every saturation of a run is
+// counted (RunTotals::fixed_saturations).
 #pragma once
 
 #include <cmath>
@@ -17,51 +24,20 @@
 #include "sim_host/engines/model_info.hpp"
 #include "vines/build_model.hpp"
 #include "vines/contact_laws.hpp"
-#include "vines/fixed/frame.hpp"
-#include "vines/fixed/vines_step.hpp"
+#include "vines/fixed/image.hpp"
+#include "vines/fixed/node_model.hpp"
 #include "vines/sim.hpp"
 
 namespace vines::host {
 
-// Q3.28, the format of every fixed-point value (docs/fixed_point.md).
-inline constexpr int kFixedBits = 28;
-
-// The fixed-point model and step of a device: the bare frame's here, the VI
-// NES's below.
-template <int N, typename Dev>
-struct FixedOf {
-  using M = fixed::FixedFrame<kFixedBits, Model<double, N, Dev>::kP>;
-  using D = fixed::FixedFrameData<M>;
-  static M build(const Model<double, N, Dev>& m, const FixedParams& f) {
-    return fixed::build_fixed_frame<kFixedBits>(m, f.accel_mps2, f.amplification);
-  }
-  static const fixed::FixedFrame<kFixedBits, M::kP>& frame(const M& m) { return m; }
-  static const fixed::FixedFrameData<M>& frame(const D& d) { return d; }
-  static void init(const M& m, D& d, typename M::Q /*v0*/, typename M::Q a0) { fixed::fixed_frame_init(m, d, a0); }
-  static void step(const M& m, D& d, typename M::Q a1) { fixed::fixed_frame_step(m, d, a1); }
-};
-
-template <int N, ContactLaw L>
-struct FixedOf<N, VinesDevice<L>> {
-  using M = decltype(fixed::build_fixed_vines<kFixedBits, fixed::kFixedMoments, LawOf<L>>(
-      std::declval<const Model<double, N, VinesDevice<L>>&>(), fixed::FixedScales{}));
-  using D = fixed::FixedVinesData<M>;
-  static M build(const Model<double, N, VinesDevice<L>>& m, const FixedParams& f) {
-    return fixed::build_fixed_vines<kFixedBits, fixed::kFixedMoments, LawOf<L>>(
-        m, fixed::FixedScales{f.accel_mps2, f.amplification, f.contact_speed_mps});
-  }
-  static const typename M::Frame& frame(const M& m) { return m.frame; }
-  static const fixed::FixedFrameData<typename M::Frame>& frame(const D& d) { return d.frame; }
-  static void init(const M& m, D& d, typename M::Q v0, typename M::Q a0) { fixed::fixed_vines_init(m, d, v0, a0); }
-  static void step(const M& m, D& d, typename M::Q a1) { fixed::fixed_vines_step(m, d, a1); }
-};
-
 template <int N, typename Dev>
 class FixedEngine final : public Engine {
   static constexpr bool kVines = Dev::kKind == DeviceKind::kVines;
-  using Of = FixedOf<N, Dev>;
-  using FM = typename Of::M;
-  using FD = typename Of::D;
+  static constexpr bool kTmd = Dev::kKind == DeviceKind::kTmd;
+  using NM = fixed::NodeModel<N, Dev>;
+  using Of = typename NM::Step;
+  using FM = typename NM::M;
+  using FD = typename NM::D;
   using Q = typename FM::Q;
   using DModel = Model<double, N, Dev>;
   using DData = Data<double, N, Dev>;
@@ -76,17 +52,36 @@ class FixedEngine final : public Engine {
     const ParamError e = build_model(p, dm_.get());
     if (!e.ok()) return e;
     fixed_ = p.fixed;
-    *fm_ = Of::build(*dm_, fixed_);
+    fixed::build_node_model(*dm_, fixed_, nm_.get());
+    if constexpr (kTmd) {
+      if (!nm_->step.ok)
+        return {"loop.scalar", "no fixed-point block form for this TMD (its transition has a defective or "
+                               "ill-conditioned eigenbasis): run it in double or float"};
+    }
     return {};
   }
   ParamError set_initial_conditions(const SceneParams& p) override {
     const ParamError e = vines::set_initial_conditions(p.device, dm_.get());
-    if (e.ok()) *fm_ = Of::build(*dm_, fixed_);
+    if (e.ok()) fixed::build_node_model(*dm_, fixed_, nm_.get());
     return e;
   }
-  std::vector<std::uint8_t> model_image() const override { return {}; }
-  std::string load_image(const std::uint8_t*, std::size_t) override {
-    return "a fixed-point engine (loop.scalar = \"fixed\") has no model image yet";
+  // The fixed-point model image (fixed/image.hpp): the node model's bytes.
+  std::vector<std::uint8_t> model_image() const override {
+    const fixed::ImageKind k = fixed::image_kind<N, Dev>();
+    std::vector<std::uint8_t> out(fixed::kImageHeaderBytes + k.body);
+    out.resize(fixed::write_image(k, nm_.get(), out.data(), out.size()));
+    return out;
+  }
+  // An image replaces the node model built from the scene (whose double
+  // model still reads the state back), as on a board.
+  std::string load_image(const std::uint8_t* p, std::size_t n) override {
+    auto loaded = std::make_unique<NM>();
+    fixed::ImageLoader loader(fixed::image_kind<N, Dev>(), loaded.get());
+    const char* why = loader.push(p, n);
+    if (!why) why = loader.finish();
+    if (why) return why;
+    nm_ = std::move(loaded);
+    return {};
   }
   ModelInfo info() const override { return model_info(*dm_); }
 
@@ -94,9 +89,7 @@ class FixedEngine final : public Engine {
     const std::uint32_t sat0 = numeric::fixed_saturations();
     count_ = Counters{};
     last_good_ = 0;  // a non-finite first sample is held at 0 (and counted)
-    Q v0 = Q(0);
-    if constexpr (kVines) v0 = Q(dm_->dev.v0 / fm_->speed);
-    Of::init(*fm_, *fd_, v0, sample(a0));
+    fixed::node_init(*nm_, *fd_, sample(a0));
     saturations_ = numeric::fixed_saturations() - sat0;
     peaks_.setZero();
     drifts_.setZero();
@@ -107,7 +100,7 @@ class FixedEngine final : public Engine {
   void run(const double* a, std::size_t n) override {
     const std::uint32_t sat0 = numeric::fixed_saturations();
     for (std::size_t k = 0; k < n; ++k) {
-      Of::step(*fm_, *fd_, sample(a[k]));
+      fixed::node_step(*nm_, *fd_, sample(a[k]));
       if (dm_->loop.floor_peaks) floor_peaks();
     }
     saturations_ += numeric::fixed_saturations() - sat0;
@@ -115,25 +108,33 @@ class FixedEngine final : public Engine {
 
   Snapshot snapshot() const override {
     const auto& fd = Of::frame(*fd_);
+    const NM& nm = *nm_;
     const DData& d = shadow();
     Snapshot s;
     s.t = fd.steps * dm_->h;
     s.ag = static_cast<double>(fd.a_prev) * fm_frame().sa;
-    const auto x = floor_displacements(*dm_, d), v = floor_velocities(*dm_, d), acc = absolute_accel(*dm_, d);
+    const auto v = floor_velocities(*dm_, d), acc = absolute_accel(*dm_, d);
     for (int i = 0; i < N; ++i) {
-      s.x[i] = x(i);
+      s.x[i] = fixed::floor_x(nm.read, fd.z, i);
       s.v[i] = v(i);
       s.acc[i] = acc(i);
       s.drift[i] = s.x[i] - (i ? s.x[i - 1] : 0.0);
     }
+    Q force = Q(0);
+    if constexpr (kVines) force = fixed::contact_force(nm, *fd_);
+    s.acc[N - 1] = fixed::top_acceleration(nm.read, fd.z, force);
     s.elastic_energy = static_cast<double>(fd.ee) * fm_frame().ee_unit;
     if constexpr (kVines) {
-      s.particle_x = dm_->dev.y0 + d.s;
-      s.particle_v = d.sd;
+      s.particle_x = static_cast<double>(nm.particle_y0 + fd_->s) * nm.step.length;
+      s.particle_v = static_cast<double>(fd_->sd) * nm.step.speed;
       s.wall_left = s.x[dm_->floor] - dm_->dev.design.gap;
       s.wall_right = s.x[dm_->floor] + dm_->dev.design.gap;
-      s.contact_force = d.contact_force;
+      s.contact_force = static_cast<double>(force) * nm.force_unit;
       s.mode = static_cast<int>(d.mode);
+    }
+    if constexpr (kTmd) {
+      s.tmd_x = d.z(N);
+      s.tmd_v = d.z(2 * N + 1);
     }
     return s;
   }
@@ -164,52 +165,56 @@ class FixedEngine final : public Engine {
     r.peak_top_velocity = static_cast<double>(fd.peak_top_velocity) * fm_frame().top_speed;
     r.elastic_energy = static_cast<double>(fd.ee) * fm_frame().ee_unit;
     r.strain_increments = strain_increments_;
-    if constexpr (kVines) r.max_overlap = static_cast<double>(fd_->max_depth) * fm_->cu.u.d;
+    if constexpr (kVines) r.max_overlap = static_cast<double>(fd_->max_depth) * nm_->step.cu.u.d;
     r.count = counters();
     r.fixed_saturations = saturations_;
     return r;
   }
 
  private:
-  const fixed::FixedFrame<kFixedBits, P>& fm_frame() const { return Of::frame(*fm_); }
+  const auto& fm_frame() const { return Of::frame(nm_->step); }
 
   // A sample in the model's unit; a non-finite one is replaced by the last
   // good one and counted, as the double loop does.
   Q sample(double a) {
     if (std::isfinite(a)) last_good_ = a;
     else ++count_.bad_samples;
-    return Q(last_good_ / fm_frame().sa);
+    return fixed::sample_of<Q>(last_good_, fm_frame().sa);
   }
 
   // The fixed state read back in double, in a Data of the double model (for
-  // the double model's output functions): modes, particle, contact force.
+  // the double model's output functions): modes, particle, contact mode.
   const DData& shadow() const {
     DData& d = *shadow_;
     shadow_modes();
     if constexpr (kVines) {
-      const FM& m = *fm_;
+      const FM& m = nm_->step;
       d.s = static_cast<double>(fd_->s) * m.length;
       d.sd = static_cast<double>(fd_->sd) * m.speed;
       d.xf = dm_->floor_x(d.z)(dm_->floor);
-      const double vf = dm_->floor_v(d.z)(dm_->floor);
       const int side = fd_->side;
       d.mode = side < 0 ? Mode::kContactLeft : side > 0 ? Mode::kContactRight : Mode::kFree;
-      d.contact_force = 0;
-      if (side != 0) {
-        const double overlap = static_cast<double>(fd_->overlap) * m.length, rate = side * (d.sd - vf);
-        d.contact_force = -side * dm_->dev.law(overlap, rate).total();
-      }
+      d.contact_force = static_cast<double>(fixed::contact_force(*nm_, *fd_)) * nm_->force_unit;
     }
     return d;
   }
 
-  // The modes alone, in SI, into the shadow Data.
+  // The modes alone (a TMD: the frame and the TMD, z = T diag(u) y), in SI,
+  // into the shadow Data.
   void shadow_modes() const {
     const auto& fd = Of::frame(*fd_);
     const auto& fr = fm_frame();
-    for (int j = 0; j < P; ++j) {
-      shadow_->z(j) = static_cast<double>(fd.z(j)) * fr.sq(j);
-      shadow_->z(P + j) = static_cast<double>(fd.z(P + j)) * fr.sv(j);
+    if constexpr (kTmd) {
+      Eigen::Matrix<double, 2 * P, 1> y;
+      for (int k = 0; k < 2 * P; ++k) y(k) = static_cast<double>(fd.z(k));
+      shadow_->z = fr.back * y;
+    } else {
+      constexpr int PF = std::decay_t<decltype(fr)>::kP;  // the fixed step's modes: the real ones
+      shadow_->z.setZero();
+      for (int j = 0; j < PF; ++j) {
+        shadow_->z(j) = static_cast<double>(fd.z(j)) * fr.sq(j);
+        shadow_->z(P + j) = static_cast<double>(fd.z(PF + j)) * fr.sv(j);
+      }
     }
   }
 
@@ -228,21 +233,26 @@ class FixedEngine final : public Engine {
     return c;
   }
 
-  // The floors' peaks, drifts and positive strain increments (loop.floor_peaks), in double.
+  // The floors' peaks and drifts (the floors as the snapshot reads them) and
+  // the positive strain increments (loop.floor_peaks).
   void floor_peaks() {
-    shadow_modes();  // the floors need the modes only, not the particle's contact force
-    const DData& d = *shadow_;
-    const Eigen::Matrix<double, N, 1> x = dm_->floor_x(d.z);
-    peaks_ = peaks_.cwiseMax(x.cwiseAbs());
-    for (int i = 0; i < N; ++i) drifts_(i) = std::fmax(drifts_(i), std::fabs(x(i) - (i ? x(i - 1) : 0.0)));
-    const double strain = dm_->strain.eval(d.z, 0.0);
+    const auto& z = Of::frame(*fd_).z;
+    double below = 0;
+    for (int i = 0; i < N; ++i) {
+      const double x = fixed::floor_x(nm_->read, z, i);
+      peaks_(i) = std::fmax(peaks_(i), std::fabs(x));
+      drifts_(i) = std::fmax(drifts_(i), std::fabs(x - below));
+      below = x;
+    }
+    shadow_modes();  // the strain needs the modes only, not the particle's contact force
+    const double strain = dm_->strain.eval(shadow_->z, 0.0);
     if (strain > last_strain_) strain_increments_ += strain - last_strain_;
     last_strain_ = strain;
   }
 
   // Heap on the host (the blocks can be large); the firmware keeps them static.
   std::unique_ptr<DModel> dm_ = std::make_unique<DModel>();
-  std::unique_ptr<FM> fm_ = std::make_unique<FM>();
+  std::unique_ptr<NM> nm_ = std::make_unique<NM>();
   std::unique_ptr<FD> fd_ = std::make_unique<FD>();
   std::unique_ptr<DData> shadow_ = std::make_unique<DData>();
   FixedParams fixed_;

@@ -41,11 +41,35 @@ struct FixedFrame {
   GainP ee;            // a mode's strain energy times h, in E_e's unit
 };
 
+// The modal step's first N modes (the real ones: a build that pads the
+// modes to its SIMD width, Layout::kLanes, pads past them).
+template <int N, typename S, int P>
+ModalLti<S, N> real_modes(const ModalLti<S, P>& l) {
+  static_assert(N <= P, "more modes than the step has");
+  ModalLti<S, N> o;
+  o.p11 = l.p11.template head<N>();
+  o.p12 = l.p12.template head<N>();
+  o.p21 = l.p21.template head<N>();
+  o.p22 = l.p22.template head<N>();
+  o.gx0 = l.gx0.template head<N>();
+  o.gx1 = l.gx1.template head<N>();
+  o.gv0 = l.gv0.template head<N>();
+  o.gv1 = l.gv1.template head<N>();
+  o.ak = l.ak.template head<N>();
+  o.ac = l.ac.template head<N>();
+  o.bgv = l.bgv.template head<N>();
+  o.bfv = l.bfv.template head<N>();
+  return o;
+}
+
 // The fixed-point frame of the double model m (a modal one: no device or a
 // VI NES), for ground accelerations up to sa [m/s^2] amplified up to amp.
+// Its N real modes only, whatever the double model's padding: the fixed
+// step runs mode by mode, and its layout is the same on every target (the
+// fixed-point model image, fixed/image.hpp).
 template <int F, int N, typename Dev>
-FixedFrame<F, Model<double, N, Dev>::kP> build_fixed_frame(const Model<double, N, Dev>& m, double sa, double amp) {
-  constexpr int P = Model<double, N, Dev>::kP;
+FixedFrame<F, N> build_fixed_frame(const Model<double, N, Dev>& m, double sa, double amp) {
+  constexpr int P = N;
   using G = numeric::Gain;
   const auto& l = m.lti;
   FixedFrame<F, P> o;
@@ -63,9 +87,9 @@ FixedFrame<F, Model<double, N, Dev>::kP> build_fixed_frame(const Model<double, N
   }
   ms.q = o.sq;
   ms.v = o.sv;
-  o.lti = numeric::scaled_modal<F, P, P>(l, ms);
-  o.top_length = m.rows.top.cwiseAbs().dot(o.sq);
-  o.top_speed = m.rows.top.cwiseAbs().dot(o.sv);
+  o.lti = real_modes<N>(numeric::scaled_modal<F, N>(l, ms));
+  o.top_length = m.rows.top.template head<N>().cwiseAbs().dot(o.sq);
+  o.top_speed = m.rows.top.template head<N>().cwiseAbs().dot(o.sv);
   o.ee_unit = 0;
   for (int j = 0; j < P; ++j) o.ee_unit += m.strain.qq(j) * o.sq(j) * o.sq(j) * m.h;
   for (int j = 0; j < P; ++j) {

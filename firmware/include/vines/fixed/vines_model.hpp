@@ -100,9 +100,9 @@ struct FixedVines {
 
 // The fixed-point model of the double model m (a VI NES on a modal frame).
 template <int F, int K, typename Law, int N, typename Dev>
-FixedVines<F, Model<double, N, Dev>::kP, Law::template Kernel, K> build_fixed_vines(
-    const Model<double, N, Dev>& m, const FixedScales& sc) {
-  constexpr int P = Model<double, N, Dev>::kP;
+FixedVines<F, N, Law::template Kernel, K> build_fixed_vines(const Model<double, N, Dev>& m,
+                                                           const FixedScales& sc) {
+  constexpr int P = N;  // the real modes (build_fixed_frame)
   using Out = FixedVines<F, P, Law::template Kernel, K>;
   using Q = typename Out::Q;
   using G = numeric::Gain;
@@ -112,8 +112,9 @@ FixedVines<F, Model<double, N, Dev>::kP, Law::template Kernel, K> build_fixed_vi
   Out o;
   o.frame = build_fixed_frame<F>(m, sc.sa, sc.amp);
   const V sq = o.frame.sq, sv = o.frame.sv, w = sv.cwiseQuotient(sq);
-  o.length = m.rows.dev.cwiseAbs().dot(sq) / 8.0 + std::fmax(std::fabs(dm.wall_left), std::fabs(dm.wall_right));
-  o.speed = m.rows.dev.cwiseAbs().dot(sv) + sc.v_contact;
+  const V dev = m.rows.dev.template head<N>();
+  o.length = dev.cwiseAbs().dot(sq) / 8.0 + std::fmax(std::fabs(dm.wall_left), std::fabs(dm.wall_right));
+  o.speed = dev.cwiseAbs().dot(sv) + sc.v_contact;
   const double L = o.length, Vp = o.speed, h = m.h;
   for (int j = 0; j < P; ++j) {
     o.dev_x[j] = G(m.rows.dev(j) * sq(j) / L);
@@ -143,7 +144,7 @@ FixedVines<F, Model<double, N, Dev>::kP, Law::template Kernel, K> build_fixed_vi
   // The coupling's constants: split_coupling's on a state at rest.
   const auto fm = force_moments<K>(l);
   const ContactCoupling<double, K> c_si =
-      vines::detail::split_coupling(m, fm, Eigen::Matrix<double, 2 * P, 1>::Zero().eval(), 0.0, 0.0, 1);
+      vines::detail::split_coupling(m, fm, Model<double, N, Dev>::VecX::Zero().eval(), 0.0, 0.0, 1);
   for (int n = 0; n < Out::kShrinks; ++n) {
     const CouplingUnits shrunk{contact_units(dm.m, dm.c, std::ldexp(sc.v_contact, -5 * n)), h};
     o.coupling[n] = scaled_coupling<Q, G>(c_si, shrunk);

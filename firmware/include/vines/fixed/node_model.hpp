@@ -1,0 +1,172 @@
+// A device's whole fixed-point model (issue 34): its step (the bare frame's
+// modes, fixed/frame.hpp; the TMD's blocks, fixed/tmd.hpp; the VI NES,
+// fixed/vines_step.hpp), its readout (fixed/readout.hpp) and its initial
+// conditions, one block of static data: what the host's fixed-point engine
+// runs and what the fixed-point model image (fixed/image.hpp) carries to a
+// board, so host and board step and read the same bits.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "vines/fixed/frame.hpp"
+#include "vines/fixed/image.hpp"
+#include "vines/fixed/readout.hpp"
+#include "vines/fixed/tmd.hpp"
+#include "vines/fixed/vines_step.hpp"
+#include "vines/numeric/fixed_math.hpp"
+
+namespace vines::fixed {
+
+// Q3.28, the format of every fixed-point value (docs/fixed_point.md).
+inline constexpr int kFixedBits = 28;
+
+// The step of a device in fixed point: its model M and data D, and what
+// every device reads the same way: frame(m) (sa, ee_unit, top_length,
+// top_speed) and frame(d) (z, a_prev, steps, peaks, E_e). The bare frame's
+// here, the TMD's and the VI NES's below.
+template <int N, typename Dev>
+struct DeviceStep {
+  using M = FixedFrame<kFixedBits, N>;
+  using D = FixedFrameData<M>;
+  static const M& frame(const M& m) { return m; }
+  static const D& frame(const D& d) { return d; }
+  static void init(const M& m, D& d, typename M::Q /*x0*/, typename M::Q /*v0*/, typename M::Q a0) {
+    fixed_frame_init(m, d, a0);
+  }
+  static void step(const M& m, D& d, typename M::Q a1) { fixed_frame_step(m, d, a1); }
+};
+
+template <int N>
+struct DeviceStep<N, TmdDevice> {
+  using M = FixedTmd<kFixedBits, N + 1>;
+  using D = FixedFrameData<M>;
+  static const M& frame(const M& m) { return m; }
+  static const D& frame(const D& d) { return d; }
+  // x0, v0: the TMD's initial displacement and speed [Ld, Vd].
+  static void init(const M& m, D& d, typename M::Q x0, typename M::Q v0, typename M::Q a0) {
+    fixed_tmd_init(m, d, x0, v0, a0);
+  }
+  static void step(const M& m, D& d, typename M::Q a1) { fixed_tmd_step(m, d, a1); }
+};
+
+template <int N, ContactLaw L>
+struct DeviceStep<N, VinesDevice<L>> {
+  using M = FixedVines<kFixedBits, N, LawOf<L>::template Kernel, kFixedMoments>;
+  using D = FixedVinesData<M>;
+  static const typename M::Frame& frame(const M& m) { return m.frame; }
+  static const FixedFrameData<typename M::Frame>& frame(const D& d) { return d.frame; }
+  // v0: the particle's initial speed [Vp].
+  static void init(const M& m, D& d, typename M::Q /*x0*/, typename M::Q v0, typename M::Q a0) {
+    fixed_vines_init(m, d, v0, a0);
+  }
+  static void step(const M& m, D& d, typename M::Q a1) { fixed_vines_step(m, d, a1); }
+};
+
+template <int N, typename Dev>
+struct NodeModel {
+  using Step = DeviceStep<N, Dev>;
+  using M = typename Step::M;
+  using D = typename Step::D;
+  using Q = typename M::Q;
+  static constexpr int kNx = 2 * M::kP;
+
+  M step;
+  FixedReadout<N, kNx> read;
+  double h = 0;          // the sensor step [s]
+  int split_steps = 0;   // the scene's loop.split_steps the step was built with
+  Q x0 = Q(0), v0 = Q(0);  // initial conditions: a TMD's displacement and speed, a particle's speed
+  Q particle_y0 = Q(0);    // VI NES: where the particle starts, from the box's centre [L]
+  double force_unit = 0;   // VI NES: the readout's unit of the contact force, m V^2 / D [N]
+};
+
+// The image's identity of this instance.
+template <int N, typename Dev>
+constexpr ImageKind image_kind() {
+  ImageKind k;
+  k.device = static_cast<std::uint8_t>(Dev::kKind);
+  if constexpr (Dev::kKind == DeviceKind::kVines) k.law = static_cast<std::uint8_t>(Dev::kLaw);
+  k.stories = static_cast<std::uint8_t>(N);
+  k.bits = static_cast<std::uint8_t>(kFixedBits);
+  k.moments = static_cast<std::uint8_t>(kFixedMoments);
+  k.align = static_cast<std::uint8_t>(alignof(NodeModel<N, Dev>));
+  k.body = static_cast<std::uint32_t>(sizeof(NodeModel<N, Dev>));
+  return k;
+}
+
+// A ground sample [m/s^2] in the model's unit sa (the host's and the
+// board's one division, the same bits).
+template <typename Q>
+Q sample_of(double a, double sa) {
+  return Q(a / sa);
+}
+
+template <int N, typename Dev>
+void node_init(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a0) {
+  NodeModel<N, Dev>::Step::init(nm.step, d, nm.x0, nm.v0, a0);
+}
+template <int N, typename Dev>
+void node_step(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a1) {
+  NodeModel<N, Dev>::Step::step(nm.step, d, a1);
+}
+
+// The VI NES's contact force on the particle at the step's end, positive to
+// the right (the double model's contact_force), in the readout's unit F_u:
+// the law's kernel in the contact's units at the overlap and its rate.
+template <int N, ContactLaw L>
+numeric::Fixed<kFixedBits> contact_force(const NodeModel<N, VinesDevice<L>>& nm,
+                                         const typename NodeModel<N, VinesDevice<L>>::D& d) {
+  using Q = numeric::Fixed<kFixedBits>;
+  constexpr int P = NodeModel<N, VinesDevice<L>>::M::kP;
+  if (d.side == 0) return Q(0);
+  const auto& m = nm.step;
+  const Q vf = gain_dot<Q>(m.dev_v, d.frame.z.template tail<P>());
+  const Q q = numeric::sqrt(numeric::sqrt(d.overlap * m.to_overlap));
+  const Q u = Q(d.side) * (d.sd - vf) * m.to_speed;
+  const Q f = m.law[0].regular(q, u).total();
+  return d.side > 0 ? -f : f;
+}
+
+#if VINES_MODEL_REPORT
+// The node model of the double model m and the scene's fixed-point scales.
+template <int N, typename Dev>
+void build_node_model(const Model<double, N, Dev>& m, const FixedParams& f, NodeModel<N, Dev>* out) {
+  using NM = NodeModel<N, Dev>;
+  using Q = typename NM::Q;
+  constexpr int NX = NM::kNx;
+  NM& nm = *out;
+  nm.x0 = nm.v0 = nm.particle_y0 = Q(0);
+  nm.force_unit = 0;
+  nm.h = m.h;
+  nm.split_steps = m.loop.split_steps;
+  constexpr int DX = Model<double, N, Dev>::kNx, DP = Model<double, N, Dev>::kP;
+  Eigen::Matrix<double, DX, NX> to_z = Eigen::Matrix<double, DX, NX>::Zero();
+  double f_unit = 0;
+  if constexpr (Dev::kKind == DeviceKind::kTmd) {
+    nm.step = build_fixed_tmd<kFixedBits>(m, f.accel_mps2, f.amplification);
+    to_z = nm.step.back;
+    nm.x0 = Q(m.dev.x0 / nm.step.dev_length);
+    nm.v0 = Q(m.dev.v0 / nm.step.dev_speed);
+  } else {
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      nm.step = build_fixed_vines<kFixedBits, kFixedMoments, LawOf<Dev::kLaw>>(
+          m, FixedScales{f.accel_mps2, f.amplification, f.contact_speed_mps});
+      nm.v0 = Q(m.dev.v0 / nm.step.speed);
+      nm.particle_y0 = Q(m.dev.y0 / nm.step.length);
+      f_unit = nm.force_unit = nm.step.cu.u.force();
+    } else {
+      nm.step = build_fixed_frame<kFixedBits>(m, f.accel_mps2, f.amplification);
+    }
+    const auto& fr = NM::Step::frame(nm.step);
+    constexpr int P = NM::M::kP;
+    for (int j = 0; j < P; ++j) {  // the double model's modes, padded to DP
+      to_z(j, j) = fr.sq(j);
+      to_z(DP + j, P + j) = fr.sv(j);
+    }
+  }
+  nm.read = build_readout<N, Dev, NX>(m, to_z, f_unit);
+}
+#endif
+
+}  // namespace vines::fixed
