@@ -56,6 +56,29 @@ TEST(Hil, CleanRunEqualsTheOfflineRunBitForBit) {
   }
 }
 
+// The host node runs the fixed-point model image of each device (what the
+// Cortex-M3 board loads), equal to the offline run; a scene asking for what
+// fixed point does not keep is refused by key.
+TEST(Hil, FixedPointNodeEqualsTheOfflineRun) {
+  for (const char* device : {"bare", "tmd", "vines"}) {
+    const Scene sc =
+        load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_" + device + "_fixed.toml");
+    const HilReport r = run_hil(sc, base(5));
+    EXPECT_EQ(r.steps, 5001) << device;
+    EXPECT_TRUE(r.bit_exact) << device;
+    EXPECT_EQ(r.max_deviation_from_offline, 0.0) << device;
+    EXPECT_GT(r.max_abs_floor_displacement_m, 0.01) << device;
+  }
+  Scene ledger = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_bare.toml");  // energy_ledger = true
+  ledger.scalar = Scalar::kFixed;
+  try {
+    run_hil(ledger, base(1));
+    ADD_FAILURE() << "a fixed-point node with the ledger ran";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("loop.energy_ledger"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Hil, RealTimeRunKeepsPaceAndEqualsOffline) {
   HilOptions o = base(2.0);
   o.realtime = true;

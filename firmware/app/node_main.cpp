@@ -5,9 +5,16 @@
 // VINES_APP_LAW, a struct of the registry, contact_laws.hpp), 10 stories,
 // in the toolchain's scalar. The application loop is firmware/app/node_app.hpp,
 // the same source the host's `vines node` runs.
+// A fixed-point board (VINES_APP_FIXED, scalar "fixed" in hal/mcu/boards.txt)
+// runs the Q3.28 model instead (vines/link/fixed_plant.hpp), from the
+// fixed-point model image.
 // Exit status (semihosting): 0 after STOP, 1 if the link stays silent.
 #include "node_app.hpp"
+#if VINES_APP_FIXED
+#include "vines/link/fixed_plant.hpp"
+#else
 #include "vines/link/model_plant.hpp"
+#endif
 
 // Eigen's data layout is the same on every target (host x86-64 with SSE2 or
 // AVX2, Cortex-M without SIMD): fixed-size objects 16-byte aligned.
@@ -15,7 +22,6 @@ static_assert(EIGEN_MAX_STATIC_ALIGN_BYTES == 16, "Eigen alignment differs from 
 
 namespace {
 
-using Scalar = VINES_APP_SCALAR;
 constexpr int kStories = 10;
 #if VINES_APP_DEVICE == 0
 using Dev = vines::NoDevice;
@@ -27,12 +33,16 @@ using Dev = vines::VinesDevice<vines::laws::VINES_APP_LAW::kTag>;
 #error "VINES_APP_DEVICE must be 0 (bare frame), 1 (tmd) or 2 (vines, with VINES_APP_LAW)"
 #endif
 
-using Plant = vines::link::ModelPlant<Scalar, kStories, Dev>;
+#if VINES_APP_FIXED
+using Plant = vines::link::FixedPlant<kStories, Dev>;
+#else
+using Plant = vines::link::ModelPlant<VINES_APP_SCALAR, kStories, Dev>;
+#endif
 using Timed = vines::app::TimedPlant<Plant>;
 
 // Static blocks: the model, the run's data and the node never live on the stack.
-vines::Model<Scalar, kStories, Dev> g_model;
-vines::Data<Scalar, kStories, Dev> g_data;
+Plant::ModelT g_model;
+Plant::DataT g_data;
 Plant g_plant(&g_model, &g_data);
 Timed g_timed(&g_plant);
 vines::app::PortSink g_sink;

@@ -79,12 +79,9 @@ void choose_node(Bench* b) {
 }
 
 link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
-  if (scene.scalar == Scalar::kFixed)
-    throw std::runtime_error(scene.path + ": loop.scalar = \"fixed\": no node runs the fixed-point engine yet (the "
-                             "boards run \"double\" or \"float\")");
   link::NodeConfig c;
   c.scene = scene.params;
-  c.scalar = scene.scalar == Scalar::kFloat ? 1 : 0;
+  c.scalar = link_code(scene.scalar);
   c.mode = kNodeModes[static_cast<int>(opt.mode)];
   c.sensor_range_mps2 = opt.saturate_g * kGravity;
   c.grace_periods = opt.grace_periods;

@@ -24,7 +24,7 @@ struct OfflineFeed {
 }  // namespace
 
 std::vector<std::uint8_t> model_image(const link::NodeConfig& cfg, const std::string& what) {
-  const Scalar scalar = cfg.scalar ? Scalar::kFloat : Scalar::kDouble;
+  const Scalar scalar = scalar_of_code(cfg.scalar);
   if (cfg.mode != link::NodeMode::kHybrid) return build_engine(cfg.scene, scalar, what)->model_image();
   // Hybrid: the bare frame's modes (the device is on the table).
   SceneParams bare = cfg.scene;

@@ -6,6 +6,11 @@ namespace vines::host {
 
 enum class Scalar { kDouble, kFloat, kFixed };
 
+// The link's code of a scalar (link::NodeConfig::scalar) and back; a code
+// past the last is read as double (decode() refuses it first).
+inline unsigned char link_code(Scalar s) { return static_cast<unsigned char>(s); }
+inline Scalar scalar_of_code(unsigned char c) { return c <= 2 ? static_cast<Scalar>(c) : Scalar::kDouble; }
+
 inline const char* scalar_name(Scalar s) {
   return s == Scalar::kFloat ? "float" : s == Scalar::kFixed ? "fixed" : "double";
 }

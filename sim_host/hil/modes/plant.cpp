@@ -101,7 +101,7 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     twin_.reset();
     return !why || refuse(why);
   }
-  const Scalar scalar = c.scalar ? Scalar::kFloat : Scalar::kDouble;
+  const Scalar scalar = scalar_of_code(c.scalar);
   try {
     engine_ = engine_for(c.scene, scalar, "node");
   } catch (const EngineError& e) {

@@ -34,7 +34,7 @@ inline constexpr std::uint8_t kCompKinds = 3;
 
 struct NodeConfig {
   SceneParams scene;
-  std::uint8_t scalar = 0;  // 0 double, 1 float
+  std::uint8_t scalar = 0;  // 0 double, 1 float, 2 Q3.28 fixed point
   NodeMode mode = NodeMode::kReplay;
   // Fault policy (docs/link_protocol.md):
   double sensor_range_mps2 = 0;  // |a| at or beyond it: saturated (0: no range)
@@ -150,7 +150,7 @@ inline bool decode(const std::uint8_t* p, std::size_t len, NodeConfig* c) {
   l.floor_peaks = (outputs & 2) != 0;
   c->scalar = r.u8();
   const std::uint8_t mode = r.u8();
-  if (c->scalar > 1 || mode > static_cast<std::uint8_t>(NodeMode::kHybrid)) return false;
+  if (c->scalar > 2 || mode > static_cast<std::uint8_t>(NodeMode::kHybrid)) return false;
   c->mode = static_cast<NodeMode>(mode);
   for (double* x : {&c->sensor_range_mps2, &c->grace_periods, &c->stall_periods, &c->residual_limit_mps2,
                     &c->residual_window_s, &c->comp_delay_s})
