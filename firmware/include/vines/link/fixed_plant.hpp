@@ -13,9 +13,11 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "vines/contact_mode.hpp"
 #include "vines/fixed/node_model.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/link/status_text.hpp"
 #include "vines/numeric/fixed.hpp"
 
 namespace vines::link {
@@ -42,14 +44,10 @@ class FixedPlant {
   const char* image_finish() { return loader_.finish(); }
 
   bool configure(const NodeConfig& c, char* msg, std::size_t cap) {
-    configured_ = false;
     const char* why = check(c);
-    if (why) {
-      copy(why, msg, cap);
-      return false;
-    }
-    configured_ = true;
-    return true;
+    if (why) copy_text(why, msg, cap);
+    configured_ = why == nullptr;
+    return configured_;
   }
 
   void sense(const double*, int) {}  // the open-loop twin reads no floor
@@ -76,7 +74,8 @@ class FixedPlant {
       t->particle_x = static_cast<double>(m.particle_y0 + d.s) * m.step.length;
       t->particle_v = static_cast<double>(d.sd) * m.step.speed;
       t->contact_force = static_cast<double>(force) * m.force_unit;
-      t->contact_mode = static_cast<std::uint8_t>(d.side < 0 ? 1 : d.side > 0 ? 2 : 0);
+      const Mode mode = d.side < 0 ? Mode::kContactLeft : d.side > 0 ? Mode::kContactRight : Mode::kFree;
+      t->contact_mode = static_cast<std::uint8_t>(mode);
     }
     t->acc_top = fixed::top_acceleration(m.read, fd.z, force);
     t->elastic_energy = static_cast<double>(fd.ee) * ModelT::Step::frame(m.step).ee_unit;
@@ -115,12 +114,6 @@ class FixedPlant {
       return "loop.sensor_rate_hz: differs from the model image's";
     if (c.scene.loop.energy_ledger) return "loop.energy_ledger: not kept in fixed point yet";
     return nullptr;
-  }
-
-  static void copy(const char* s, char* out, std::size_t cap) {
-    std::size_t i = 0;
-    for (; s[i] != '\0' && i + 1 < cap; ++i) out[i] = s[i];
-    if (cap > 0) out[i] = '\0';
   }
 
   ModelT* model_;

@@ -16,6 +16,7 @@
 #include "vines/link/config.hpp"
 #include "vines/link/hybrid_frame.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/link/status_text.hpp"
 #include "vines/model_image.hpp"
 #include "vines/twin/image.hpp"
 #include "vines/sim.hpp"
@@ -68,7 +69,7 @@ class ModelPlant {
     configured_ = false;
     const char* why = check(c);
     if (why) {
-      copy(why, msg, cap);
+      copy_text(why, msg, cap);
       return false;
     }
     configured_ = true;
@@ -153,12 +154,6 @@ class ModelPlant {
 
   static constexpr const char* kNoEstimator =
       "estimator kalman: this image holds no estimator (the twin image vines_node_twin.elf does)";
-
-  static void copy(const char* s, char* out, std::size_t cap) {
-    std::size_t i = 0;
-    for (; s[i] != '\0' && i + 1 < cap; ++i) out[i] = s[i];
-    if (cap > 0) out[i] = '\0';
-  }
 
   ModelT* model_;
   DataT* data_;
