@@ -5,7 +5,7 @@ conditions, per contact scheme; flash and RAM (arm-none-eabi-size); stack
 (painted high-water mark from the runs, and the call-graph bound of
 -fcallgraph-info=su); the highest sensor rate the worst step sustains.
 
-  tools/mcu_report.py [--vines PATH] [--targets cortex-m4f,cortex-m7]
+  tools/mcu_report.py [--vines PATH] [--targets cortex-m4f,cortex-m7,cortex-m3]
                       [--schemes adaptive,bounded [--bounded-substeps N]]
                       [--quick] [--duration S] [--full-scene] [--records GLOB]
                       [--only scene,records,ics,tmd,bare,twin_vines,twin_tmd,twin_bare]
@@ -15,8 +15,11 @@ conditions, per contact scheme; flash and RAM (arm-none-eabi-size); stack
 Each run is `VINES hil SCENE --node qemu:TARGET --json --image ELF
 [--duration S]` (VINES: --vines, default build/release/vines) on a scene written
 to a temporary folder (--keep-scenes DIR: to DIR, kept). Per target (cortex-m4f: float, 1000 Hz sensor rate,
-168 MHz for the rate figure; cortex-m7: double, 2048 Hz, 480 MHz) and per
-mode (contact scheme), the VI NES runs are:
+168 MHz for the rate figure; cortex-m7: double, 2048 Hz, 480 MHz; cortex-m3, not
+in the default list: Q3.28 fixed point, 1000 Hz, 120 MHz, the scenes in fixed
+point: the split scheme at split_steps 16 unless --schemes, no energy ledger,
+units for 3.5 m/s^2, no twin runs) and per mode (contact scheme), the VI NES
+runs are:
   scene    data/scenes/elcentro_vines.toml as shipped (El Centro 2688-point,
            0.3487 g, particle at rest against the left wall: u = -gap), at
            the target's rate;
@@ -135,7 +138,7 @@ def main():
     a.targets = [t for t in a.targets.split(",") if t]
     for t in a.targets:
         if t not in TARGETS:
-            raise Failure(f"unknown target {t!r} (cortex-m4f or cortex-m7)")
+            raise Failure(f"unknown target {t!r} ({', '.join(TARGETS)})")
     a.schemes = [s for s in a.schemes.split(",") if s] if a.schemes else None
     if a.only:
         a.only = [k for k in a.only.split(",") if k]

@@ -56,7 +56,7 @@ def plan(a, tmp, records_dir):
                 sc = base_scene(name, target, records_dir)
                 add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap)
         for kind, (_, name) in TWIN_KINDS.items():
-            if kind in kinds:
+            if kind in kinds and TARGETS[target][1] != "fixed":  # no twin image in fixed point
                 sc = base_scene(name, target, records_dir)
                 sc["loop"]["sensor_rate_hz"] = sc["output"]["rate_hz"] = TWIN_RATE_HZ
                 add(target, None, kind, sc, os.path.basename(sc["record"]["path"]), "at rest", cap,
