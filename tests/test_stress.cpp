@@ -302,7 +302,7 @@ TEST(Stress, ContactScalesNoRunCanKeepAreRefused) {
 
 TEST(Stress, FramesWithoutAnEngineAreRefusedTruthfully) {
   // Every frame the registry lists has its engines, and nothing else does.
-  for (Scalar scalar : {Scalar::kDouble, Scalar::kFloat})
+  for (Scalar scalar : {Scalar::kDouble, Scalar::kFloat, Scalar::kFixed})
     for (DeviceKind kind : {DeviceKind::kNone, DeviceKind::kTmd, DeviceKind::kVines})
       for (int n = 1; n <= kMaxStories; ++n) {
         SceneParams p;

@@ -64,6 +64,8 @@ struct DeviceStep<N, VinesDevice<L>> {
   static void step(const M& m, D& d, typename M::Q a1) { fixed_vines_step(m, d, a1); }
 };
 
+// The block: what the host builds (build_node_model, below), the image
+// carries byte for byte and a board runs; its data is Step's D.
 template <int N, typename Dev>
 struct NodeModel {
   using Step = DeviceStep<N, Dev>;
@@ -102,6 +104,8 @@ Q sample_of(double a, double sa) {
   return Q(a / sa);
 }
 
+// At rest (a TMD or the particle at its initial conditions) on the first
+// sample a0; one sensor step to the sample a1.
 template <int N, typename Dev>
 void node_init(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a0) {
   NodeModel<N, Dev>::Step::init(nm.step, d, nm.x0, nm.v0, a0);
