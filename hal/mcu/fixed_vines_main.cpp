@@ -1,7 +1,7 @@
 // The whole VI NES step in fixed point on an FPU-less core (Cortex-M3,
 // MPS2-AN385, soft-float ABI; issue 34): the paper's 10-story frame and
 // sphere (the default law, Kuwabara-Kono) at 1 kHz, the Q3.28 split step (vines/fixed/vines_step.hpp)
-// beside the double loop's split scheme in software floating point, both at
+// beside the double and the float loops' split scheme in software floating point, all at
 // loop.split_steps = 16 (an impact in ~10 Runge-Kutta steps; the scene
 // key's default 64 takes ~40), on the same 10 s of a two-tone ground motion
 // that makes contacts (host: 8).
@@ -26,6 +26,8 @@ constexpr vines::ContactLaw kLaw = vines::VinesParams{}.law;  // the default law
 using Dev = vines::VinesDevice<kLaw>;
 vines::Model<double, 10, Dev> g_model;
 vines::Data<double, 10, Dev> g_data;
+vines::Model<float, 10, Dev> g_model_f;
+vines::Data<float, 10, Dev> g_data_f;
 constexpr double kAmax = 1.5;  // bound of |ground| below [m/s^2]
 using FixedModel = decltype(vines::fixed::build_fixed_vines<28, vines::fixed::kFixedMoments, vines::LawOf<kLaw>>(
     g_model, vines::fixed::FixedScales{}));
@@ -44,16 +46,17 @@ int main() {
   scene.device.vines.law = kLaw;
   scene.loop.contact_scheme = vines::ContactScheme::kSplit;
   scene.loop.split_steps = 16;  // docs/fixed_point.md: the cost of 64 beside it
-  if (!vines::build_model(scene, &g_model).ok()) return 1;
+  if (!vines::build_model(scene, &g_model).ok() || !vines::build_model(scene, &g_model_f).ok()) return 1;
   g_fixed = vines::fixed::build_fixed_vines<28, vines::fixed::kFixedMoments, vines::LawOf<kLaw>>(
       g_model, vines::fixed::FixedScales{kAmax, 10.0, 1.5});
   using Q = FixedModel::Q;
   vines::numeric::fixed_saturations() = 0;
   vines::init(g_model, g_data, ground(0));
+  vines::init(g_model_f, g_data_f, static_cast<float>(ground(0)));
   vines::fixed::fixed_vines_init(g_fixed, g_state, Q(0), Q(ground(0) / kAmax));
   constexpr long kSteps = 10000;
-  std::uint32_t worst_q = 0, worst_d = 0;
-  std::uint64_t total_q = 0, total_d = 0;
+  std::uint32_t worst_q = 0, worst_d = 0, worst_f = 0;
+  std::uint64_t total_q = 0, total_d = 0, total_f = 0;
   for (long k = 1; k <= kSteps; ++k) {
     const double a1 = ground(k);
     const Q q1(a1 / kAmax);
@@ -64,7 +67,12 @@ int main() {
     t = vines::hal::counter_now();
     vines::step(g_model, g_data, a1);
     const std::uint32_t dd = vines::hal::counter_now() - t;
+    t = vines::hal::counter_now();
+    vines::step(g_model_f, g_data_f, static_cast<float>(a1));
+    const std::uint32_t df = vines::hal::counter_now() - t;
     vines::hal::irq_on();
+    worst_f = df > worst_f ? df : worst_f;
+    total_f += df;
     worst_q = dq > worst_q ? dq : worst_q;
     worst_d = dd > worst_d ? dd : worst_d;
     total_q += dq;
@@ -72,6 +80,7 @@ int main() {
   }
   vines::mcu::put_step_cost("Q3.28 VI NES step", worst_q, total_q, kSteps);
   vines::mcu::put_step_cost("double VI NES step, split scheme (software FP)", worst_d, total_d, kSteps);
+  vines::mcu::put_step_cost("float VI NES step, split scheme (software FP)", worst_f, total_f, kSteps);
   const double peak_q = static_cast<double>(g_state.frame.peak_top) * g_fixed.frame.top_length;
   const double peak_d = static_cast<double>(g_data.peak_top);
   vines_semihost_puts("RAM: fixed model ");
