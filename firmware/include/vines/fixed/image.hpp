@@ -22,6 +22,7 @@
 #include <cstring>
 
 #include "vines/link/crc32.hpp"
+#include "vines/link/wire.hpp"
 
 namespace vines::fixed {
 
@@ -44,18 +45,14 @@ inline bool is_fixed_image(const std::uint8_t* p, std::size_t n) {
 inline std::size_t write_image(const ImageKind& k, const void* body, std::uint8_t* out, std::size_t cap) {
   if (cap < kImageHeaderBytes + k.body) return 0;
   const auto* b = static_cast<const std::uint8_t*>(body);
-  const std::uint32_t crc = link::crc32(b, k.body);
-  std::memcpy(out, kImageMagic, 4);
-  out[4] = static_cast<std::uint8_t>(kImageVersion & 0xFF);
-  out[5] = static_cast<std::uint8_t>(kImageVersion >> 8);
-  const std::uint8_t fields[6] = {k.device, k.law, k.stories, k.bits, k.moments, k.align};
-  std::memcpy(out + 6, fields, 6);
-  for (int i = 0; i < 4; ++i) {
-    out[12 + i] = static_cast<std::uint8_t>(k.body >> (8 * i));
-    out[16 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
-  }
-  std::memcpy(out + kImageHeaderBytes, b, k.body);
-  return kImageHeaderBytes + k.body;
+  link::Writer w(out, cap);
+  w.bytes(kImageMagic, 4);
+  w.u16(kImageVersion);
+  for (std::uint8_t v : {k.device, k.law, k.stories, k.bits, k.moments, k.align}) w.u8(v);
+  w.u32(k.body);
+  w.u32(link::crc32(b, k.body));
+  w.bytes(b, k.body);
+  return w.ok() ? w.size() : 0;
 }
 
 // Streams an image into the model bytes of kind `want` at `body` (static
@@ -99,21 +96,18 @@ class ImageLoader {
 
  private:
   const char* check_header() {
-    const std::uint8_t* h = header_;
-    if (!is_fixed_image(h, kImageHeaderBytes))
+    if (!is_fixed_image(header_, kImageHeaderBytes))
       return "model image: not a fixed-point model image (this node runs Q3.28: loop.scalar = \"fixed\")";
-    if ((h[4] | h[5] << 8) != kImageVersion) return "fixed-point model image: another version than this node's";
-    if (h[6] != want_.device) return "device.kind: differs from the model image's";
-    if (h[7] != want_.law) return "vines.law: differs from the model image's";
-    if (h[8] != want_.stories) return "frame.stories: differs from the model image's";
-    if (h[9] != want_.bits || h[10] != want_.moments || h[11] != want_.align)
+    link::Reader r(header_ + 4, kImageHeaderBytes - 4);
+    if (r.u16() != kImageVersion) return "fixed-point model image: another version than this node's";
+    if (r.u8() != want_.device) return "device.kind: differs from the model image's";
+    if (r.u8() != want_.law) return "vines.law: differs from the model image's";
+    if (r.u8() != want_.stories) return "frame.stories: differs from the model image's";
+    const std::uint8_t bits = r.u8(), moments = r.u8(), align = r.u8();
+    if (bits != want_.bits || moments != want_.moments || align != want_.align)
       return "fixed-point model image: another format than this node's (fraction bits, moments or alignment)";
-    std::uint32_t body = 0;
-    for (int i = 0; i < 4; ++i) {
-      body |= static_cast<std::uint32_t>(h[12 + i]) << (8 * i);
-      crc_ |= static_cast<std::uint32_t>(h[16 + i]) << (8 * i);
-    }
-    if (body != want_.body) return "fixed-point model image: its model's size differs from this node's";
+    if (r.u32() != want_.body) return "fixed-point model image: its model's size differs from this node's";
+    crc_ = r.u32();
     return nullptr;
   }
 
