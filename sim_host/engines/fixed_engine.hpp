@@ -88,7 +88,7 @@ class FixedEngine final : public Engine {
   void init(double a0) override {
     const std::uint32_t sat0 = numeric::fixed_saturations();
     count_ = Counters{};
-    last_good_ = 0;  // a non-finite first sample is held at 0 (and counted)
+    hold_ = fixed::SampleHold{};  // a non-finite first sample is held at 0 (and counted)
     fixed::node_init(*nm_, *fd_, sample(a0));
     saturations_ = numeric::fixed_saturations() - sat0;
     peaks_.setZero();
@@ -108,29 +108,27 @@ class FixedEngine final : public Engine {
 
   Snapshot snapshot() const override {
     const auto& fd = Of::frame(*fd_);
-    const NM& nm = *nm_;
-    const DData& d = shadow();
+    const fixed::NodeReading<N> r = fixed::read_node(*nm_, *fd_);
+    const DData& d = shadow(r.contact_force);
     Snapshot s;
     s.t = fd.steps * dm_->h;
     s.ag = static_cast<double>(fd.a_prev) * fm_frame().sa;
     const auto v = floor_velocities(*dm_, d), acc = absolute_accel(*dm_, d);
     for (int i = 0; i < N; ++i) {
-      s.x[i] = fixed::floor_x(nm.read, fd.z, i);
+      s.x[i] = r.x[i];
       s.v[i] = v(i);
       s.acc[i] = acc(i);
       s.drift[i] = s.x[i] - (i ? s.x[i - 1] : 0.0);
     }
-    Q force = Q(0);
-    if constexpr (kVines) force = fixed::contact_force(nm, *fd_);
-    s.acc[N - 1] = fixed::top_acceleration(nm.read, fd.z, force);
-    s.elastic_energy = static_cast<double>(fd.ee) * fm_frame().ee_unit;
+    s.acc[N - 1] = r.acc_top;
+    s.elastic_energy = r.elastic_energy;
     if constexpr (kVines) {
-      s.particle_x = static_cast<double>(nm.particle_y0 + fd_->s) * nm.step.length;
-      s.particle_v = static_cast<double>(fd_->sd) * nm.step.speed;
+      s.particle_x = r.particle_x;
+      s.particle_v = r.particle_v;
       s.wall_left = s.x[dm_->floor] - dm_->dev.design.gap;
       s.wall_right = s.x[dm_->floor] + dm_->dev.design.gap;
-      s.contact_force = static_cast<double>(force) * nm.force_unit;
-      s.mode = static_cast<int>(d.mode);
+      s.contact_force = r.contact_force;
+      s.mode = static_cast<int>(r.mode);
     }
     if constexpr (kTmd) {
       s.tmd_x = d.z(N);
@@ -174,17 +172,12 @@ class FixedEngine final : public Engine {
  private:
   const auto& fm_frame() const { return Of::frame(nm_->step); }
 
-  // A sample in the model's unit; a non-finite one is replaced by the last
-  // good one and counted, as the double loop does.
-  Q sample(double a) {
-    if (std::isfinite(a)) last_good_ = a;
-    else ++count_.bad_samples;
-    return fixed::sample_of<Q>(last_good_, fm_frame().sa);
-  }
+  Q sample(double a) { return hold_.take<Q>(a, fm_frame().sa); }
 
   // The fixed state read back in double, in a Data of the double model (for
-  // the double model's output functions): modes, particle, contact mode.
-  const DData& shadow() const {
+  // the double model's output functions): modes, particle, contact mode, and
+  // the contact force the caller read [N].
+  const DData& shadow(double contact_force = 0) const {
     DData& d = *shadow_;
     shadow_modes();
     if constexpr (kVines) {
@@ -194,7 +187,7 @@ class FixedEngine final : public Engine {
       d.xf = dm_->floor_x(d.z)(dm_->floor);
       const int side = fd_->side;
       d.mode = side < 0 ? Mode::kContactLeft : side > 0 ? Mode::kContactRight : Mode::kFree;
-      d.contact_force = static_cast<double>(fixed::contact_force(*nm_, *fd_)) * nm_->force_unit;
+      d.contact_force = contact_force;
     }
     return d;
   }
@@ -220,6 +213,7 @@ class FixedEngine final : public Engine {
 
   Counters counters() const {
     Counters c = count_;
+    c.bad_samples = hold_.held;
     c.steps = Of::frame(*fd_).steps;
     if constexpr (kVines) {
       const FD& d = *fd_;
@@ -257,7 +251,7 @@ class FixedEngine final : public Engine {
   std::unique_ptr<DData> shadow_ = std::make_unique<DData>();
   FixedParams fixed_;
   Counters count_;
-  double last_good_ = 0;
+  fixed::SampleHold hold_;
   std::int64_t saturations_ = 0;
   Eigen::Matrix<double, N, 1> peaks_ = Eigen::Matrix<double, N, 1>::Zero(), drifts_ = peaks_;
   double strain_increments_ = 0, last_strain_ = 0;

@@ -6,10 +6,12 @@
 // board, so host and board step and read the same bits.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include <Eigen/Core>
 
+#include "vines/contact_mode.hpp"
 #include "vines/fixed/frame.hpp"
 #include "vines/fixed/image.hpp"
 #include "vines/fixed/readout.hpp"
@@ -97,12 +99,19 @@ constexpr ImageKind image_kind() {
   return k;
 }
 
-// A ground sample [m/s^2] in the model's unit sa (the host's and the
-// board's one division, the same bits).
-template <typename Q>
-Q sample_of(double a, double sa) {
-  return Q(a / sa);
-}
+// The ground samples [m/s^2] in the model's unit sa (one division, the
+// same bits on the host and a board); a non-finite one is replaced by the
+// last good one (0 before any) and counted, as the double loop does.
+struct SampleHold {
+  double last_good = 0;
+  std::uint32_t held = 0;
+  template <typename Q>
+  Q take(double a, double sa) {
+    if (std::isfinite(a)) last_good = a;
+    else ++held;
+    return Q(last_good / sa);
+  }
+};
 
 // At rest (a TMD or the particle at its initial conditions) on the first
 // sample a0; one sensor step to the sample a1.
@@ -130,6 +139,38 @@ numeric::Fixed<kFixedBits> contact_force(const NodeModel<N, VinesDevice<L>>& nm,
   const Q u = Q(d.side) * (d.sd - vf) * m.to_speed;
   const Q f = m.law[0].regular(q, u).total();
   return d.side > 0 ? -f : f;
+}
+
+// What a node reports of its state, read as the board and the host both
+// read it (the board's telemetry, the host engine's snapshot): the floors
+// and the top floor's acceleration from the readout, E_e, and for a VI NES
+// the particle, the contact force (on the particle, positive to the right)
+// and the contact's mode.
+template <int N>
+struct NodeReading {
+  double x[N] = {};
+  double acc_top = 0, elastic_energy = 0, particle_x = 0, particle_v = 0, contact_force = 0;
+  Mode mode = Mode::kFree;
+};
+
+template <int N, typename Dev>
+NodeReading<N> read_node(const NodeModel<N, Dev>& nm, const typename NodeModel<N, Dev>::D& d) {
+  using NM = NodeModel<N, Dev>;
+  using Q = typename NM::Q;
+  const auto& fd = NM::Step::frame(d);
+  NodeReading<N> r;
+  for (int i = 0; i < N; ++i) r.x[i] = floor_x(nm.read, fd.z, i);
+  Q force = Q(0);
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    force = contact_force(nm, d);
+    r.particle_x = static_cast<double>(nm.particle_y0 + d.s) * nm.step.length;
+    r.particle_v = static_cast<double>(d.sd) * nm.step.speed;
+    r.contact_force = static_cast<double>(force) * nm.force_unit;
+    r.mode = d.side < 0 ? Mode::kContactLeft : d.side > 0 ? Mode::kContactRight : Mode::kFree;
+  }
+  r.acc_top = top_acceleration(nm.read, fd.z, force);
+  r.elastic_energy = static_cast<double>(fd.ee) * NM::Step::frame(nm.step).ee_unit;
+  return r;
 }
 
 #if VINES_MODEL_REPORT

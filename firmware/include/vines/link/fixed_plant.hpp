@@ -13,7 +13,6 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "vines/contact_mode.hpp"
 #include "vines/fixed/node_model.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/messages.hpp"
@@ -53,34 +52,25 @@ class FixedPlant {
   void sense(const double*, int) {}  // the open-loop twin reads no floor
   void init(double a0, double /*f0*/) {
     saturations_ = numeric::fixed_saturations();
-    bad_samples_ = 0;
-    last_good_ = 0;
+    hold_ = fixed::SampleHold{};
     guard_events_ = 0;
     fixed::node_init(*model_, *data_, sample(a0));
   }
   void step(double a1, double /*f1*/) { fixed::node_step(*model_, *data_, sample(a1)); }
 
-  // What the host's fixed-point engine reports (snapshot), from the same
-  // readout.
+  // What the host's fixed-point engine reports (snapshot): fixed::read_node.
   void read(Telemetry* t) {
-    const ModelT& m = *model_;
-    const DataT& d = *data_;
-    const auto& fd = ModelT::Step::frame(d);
+    const fixed::NodeReading<N> r = fixed::read_node(*model_, *data_);
     t->n = static_cast<std::uint8_t>(N);
-    for (int i = 0; i < N; ++i) t->x[i] = fixed::floor_x(m.read, fd.z, i);
-    Q force = Q(0);
-    if constexpr (Dev::kKind == DeviceKind::kVines) {
-      force = fixed::contact_force(m, d);
-      t->particle_x = static_cast<double>(m.particle_y0 + d.s) * m.step.length;
-      t->particle_v = static_cast<double>(d.sd) * m.step.speed;
-      t->contact_force = static_cast<double>(force) * m.force_unit;
-      const Mode mode = d.side < 0 ? Mode::kContactLeft : d.side > 0 ? Mode::kContactRight : Mode::kFree;
-      t->contact_mode = static_cast<std::uint8_t>(mode);
-    }
-    t->acc_top = fixed::top_acceleration(m.read, fd.z, force);
-    t->elastic_energy = static_cast<double>(fd.ee) * ModelT::Step::frame(m.step).ee_unit;
+    for (int i = 0; i < N; ++i) t->x[i] = r.x[i];
+    t->acc_top = r.acc_top;
+    t->elastic_energy = r.elastic_energy;
+    t->particle_x = r.particle_x;
+    t->particle_v = r.particle_v;
+    t->contact_force = r.contact_force;
+    t->contact_mode = static_cast<std::uint8_t>(r.mode);
     // A held sample or a saturation: the run is degraded from here.
-    const std::uint32_t guards = bad_samples_ + (numeric::fixed_saturations() - saturations_);
+    const std::uint32_t guards = hold_.held + (numeric::fixed_saturations() - saturations_);
     if (guards != guard_events_) t->flags |= kGuard;
     guard_events_ = guards;
   }
@@ -88,13 +78,7 @@ class FixedPlant {
   bool configured() const { return configured_; }
 
  private:
-  // A non-finite sample is replaced by the last good one and counted, as the
-  // host's engine does.
-  Q sample(double a) {
-    if (std::isfinite(a)) last_good_ = a;
-    else ++bad_samples_;
-    return fixed::sample_of<Q>(last_good_, ModelT::Step::frame(model_->step).sa);
-  }
+  Q sample(double a) { return hold_.take<Q>(a, ModelT::Step::frame(model_->step).sa); }
 
   const char* check(const NodeConfig& c) const {
     if (c.scalar != 2) return "scalar: this node runs Q3.28 fixed point (loop.scalar = \"fixed\")";
@@ -119,8 +103,8 @@ class FixedPlant {
   ModelT* model_;
   DataT* data_;
   fixed::ImageLoader loader_;
-  double last_good_ = 0;
-  std::uint32_t saturations_ = 0, bad_samples_ = 0, guard_events_ = 0;
+  fixed::SampleHold hold_;
+  std::uint32_t saturations_ = 0, guard_events_ = 0;
   bool configured_ = false;
 };
 
