@@ -10,6 +10,7 @@
 
 #include "support.hpp"
 #include "vines/build_model.hpp"
+#include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
 #include "vines/numeric/fixed_modal.hpp"
 
@@ -144,6 +145,35 @@ TEST(FixedMath, WideSumsProductsRoundedOnce) {
   EXPECT_EQ(big.raw(), std::numeric_limits<std::int64_t>::max());
   EXPECT_EQ(W::of(Q(7.0)).add_product(Q(7.0), Q(7.0)).to_fixed<28>(), Q::max());  // 56 > 8
   EXPECT_EQ(fixed_saturations(), 2u);
+}
+
+// A 64-bit raw value times a Gain (the energy ledger's sums): the exact
+// 94-bit product rounded to nearest (ties away from zero), held at 2^62 and
+// counted beyond it, for every shift of the gain's exponent.
+TEST(FixedMath, WideTimesIsTheRoundedExactProduct) {
+  std::mt19937_64 rng(5);
+  constexpr __int128 kHeld = static_cast<__int128>(1) << 62;
+  int held = 0;
+  fixed_saturations() = 0;
+  for (int i = 0; i < 400000; ++i) {
+    const int bits = static_cast<int>(rng() % 63);
+    const std::int64_t x = static_cast<std::int64_t>(rng() >> (63 - bits)) * ((rng() & 1) ? 1 : -1);
+    const int exp = static_cast<int>(rng() % 120) - 90;
+    const auto mant = static_cast<std::int32_t>((rng() % (1u << 29)) + (1u << 29)) * ((rng() & 1) ? 1 : -1);
+    const numeric::Gain g = numeric::Gain::from_parts(mant, exp);
+    const __int128 p = static_cast<__int128>(x) * mant, ap = p < 0 ? -p : p;
+    const int shift = 30 - exp;
+    __int128 r = shift >= 100 ? 0 : shift > 0 ? (ap + (static_cast<__int128>(1) << (shift - 1))) >> shift
+                                              : (-shift > 62 || ap >= (kHeld >> -shift) ? kHeld : ap << -shift);
+    if (r >= kHeld) {
+      r = kHeld;
+      ++held;
+    }
+    const __int128 want = p < 0 ? -r : r;
+    ASSERT_EQ(wide_times(x, g), static_cast<std::int64_t>(want)) << x << " " << mant << " 2^" << exp;
+  }
+  EXPECT_GT(held, 1000);
+  EXPECT_EQ(fixed_saturations(), static_cast<std::uint32_t>(held));
 }
 
 // Each host thread counts its own saturations (a study's runs share a pool).

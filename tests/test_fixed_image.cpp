@@ -62,11 +62,13 @@ TEST(FixedImage, LoadedEngineRunsTheSameBits) {
   }
 }
 
-// The plant of a fixed-point board, compiled here, against the engine.
+// The plant of a fixed-point board, compiled here, against the engine (with
+// the energy ledger, the contacts' dissipation too).
 template <typename Dev>
-void plant_matches_engine(const char* device) {
+void plant_matches_engine(const char* device, bool ledger = false) {
   using Plant = link::FixedPlant<10, Dev>;
-  const Scene sc = fixed_scene(device);
+  Scene sc = fixed_scene(device);
+  sc.params.loop.energy_ledger = ledger;
   const auto eng = engine_of(sc.params);
   const std::vector<std::uint8_t> image = eng->model_image();
   auto model = std::make_unique<typename Plant::ModelT>();
@@ -99,16 +101,20 @@ void plant_matches_engine(const char* device) {
     ASSERT_EQ(t.particle_x, s.particle_x) << device << " step " << k;
     ASSERT_EQ(t.particle_v, s.particle_v) << device << " step " << k;
     ASSERT_EQ(t.contact_force, s.contact_force) << device << " step " << k;
+    ASSERT_EQ(t.dissipated, eng->probe().ledger.contact) << device << " step " << k;
     ASSERT_EQ(t.flags & link::kGuard, 0) << device << " step " << k;
     contacts += t.contact_force != 0;
   }
   if constexpr (Dev::kKind == DeviceKind::kVines) EXPECT_GT(contacts, 0);  // through contacts
+  if (ledger && Dev::kKind == DeviceKind::kVines) EXPECT_GT(eng->probe().ledger.contact, 0) << device;
 }
 
 TEST(FixedImage, BoardPlantReportsTheEngineBitForBit) {
   plant_matches_engine<NoDevice>("bare");
   plant_matches_engine<TmdDevice>("tmd");
   plant_matches_engine<VinesDevice<ContactLaw::kKuwabara>>("vines");
+  plant_matches_engine<NoDevice>("bare", true);
+  plant_matches_engine<VinesDevice<ContactLaw::kKuwabara>>("vines", true);
 }
 
 // What a fixed-point node refuses, and why.
@@ -153,6 +159,10 @@ TEST(FixedImage, RefusesBrokenForeignAndMismatched) {
   EXPECT_FALSE(plant.configure(c, msg, sizeof msg));
   EXPECT_NE(std::string(msg).find("loop.sensor_rate_hz"), std::string::npos) << msg;
   c.scene.loop.sensor_rate_hz = vines_sc.params.loop.sensor_rate_hz;
+  c.scene.loop.energy_ledger = true;  // the image keeps none
+  EXPECT_FALSE(plant.configure(c, msg, sizeof msg));
+  EXPECT_NE(std::string(msg).find("loop.energy_ledger"), std::string::npos) << msg;
+  c.scene.loop.energy_ledger = false;
   EXPECT_TRUE(plant.configure(c, msg, sizeof msg)) << msg;
 }
 

@@ -69,11 +69,19 @@ TEST(Hil, FixedPointNodeEqualsTheOfflineRun) {
     EXPECT_EQ(r.max_deviation_from_offline, 0.0) << device;
     EXPECT_GT(r.max_abs_floor_displacement_m, 0.01) << device;
   }
-  Scene ledger = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_bare.toml");  // energy_ledger = true
+  // The energy ledger (the shipped scenes keep it): the bare frame's node
+  // keeps it in fixed point too; a TMD's is refused by key.
+  Scene ledger = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_bare.toml");
+  ASSERT_TRUE(ledger.params.loop.energy_ledger);
   ledger.scalar = Scalar::kFixed;
+  const HilReport r = run_hil(ledger, base(1));
+  EXPECT_TRUE(r.bit_exact);
+  EXPECT_EQ(r.max_deviation_from_offline, 0.0);
+  Scene tmd = load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_tmd.toml");
+  tmd.scalar = Scalar::kFixed;
   try {
-    run_hil(ledger, base(1));
-    ADD_FAILURE() << "a fixed-point node with the ledger ran";
+    run_hil(tmd, base(1));
+    ADD_FAILURE() << "a fixed-point TMD node with the ledger ran";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("loop.energy_ledger"), std::string::npos) << e.what();
   }

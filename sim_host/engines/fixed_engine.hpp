@@ -47,8 +47,9 @@ class FixedEngine final : public Engine {
   ParamError build(const SceneParams& p) override {
     if (kVines && p.loop.contact_scheme != ContactScheme::kSplit)
       return {"loop.contact_scheme", "loop.scalar = \"fixed\" runs the split contact scheme only: set it to \"split\""};
-    if (p.loop.energy_ledger)
-      return {"loop.energy_ledger", "not kept in fixed point yet (loop.scalar = \"fixed\"): set it to false"};
+    if (kTmd && p.loop.energy_ledger)
+      return {"loop.energy_ledger", "not kept for a TMD in fixed point (its state is not modal): set it to false, "
+                                    "or run the scene in double or float"};
     const ParamError e = build_model(p, dm_.get());
     if (!e.ok()) return e;
     fixed_ = p.fixed;
@@ -140,6 +141,7 @@ class FixedEngine final : public Engine {
   Probe probe() const override {
     Probe p;
     p.count = counters();
+    p.ledger = ledger();
     p.peak_top = static_cast<double>(Of::frame(*fd_).peak_top) * fm_frame().top_length;
     if constexpr (kVines) {
       const DData& d = shadow();
@@ -165,6 +167,7 @@ class FixedEngine final : public Engine {
     r.strain_increments = strain_increments_;
     if constexpr (kVines) r.max_overlap = static_cast<double>(fd_->max_depth) * nm_->step.cu.u.d;
     r.count = counters();
+    r.ledger = ledger();
     r.fixed_saturations = saturations_;
     return r;
   }
@@ -209,6 +212,11 @@ class FixedEngine final : public Engine {
         shadow_->z(P + j) = static_cast<double>(fd.z(PF + j)) * fr.sv(j);
       }
     }
+  }
+
+  Ledger ledger() const {
+    if (!nm_->ledger.on) return {};
+    return Of::frame(*fd_).ledger.read(nm_->ledger.unit);
   }
 
   Counters counters() const {

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include "vines/fixed/ledger.hpp"
 #include "vines/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
@@ -109,6 +110,7 @@ struct FixedFrameData {
   Q peak_top_velocity = Q(0);  // largest |v_top| at a step's end [Vt]
   numeric::Wide<40> ee;   // E_e [ee_unit]
   std::uint32_t steps = 0, peak_step = 0;  // steps taken; the one that ended at the peak
+  FixedLedgerData ledger;  // the energy ledger, when the node model keeps one (fixed/node_model.hpp)
 };
 
 // (x0 g0 + sum_j v_j g_j) 2^shift, summed 64 bits wide and saturated once

@@ -34,6 +34,7 @@ struct DeviceStep {
   using D = FixedFrameData<M>;
   static const M& frame(const M& m) { return m; }
   static const D& frame(const D& d) { return d; }
+  static D& frame(D& d) { return d; }
   static void init(const M& m, D& d, typename M::Q /*x0*/, typename M::Q /*v0*/, typename M::Q a0) {
     fixed_frame_init(m, d, a0);
   }
@@ -46,6 +47,7 @@ struct DeviceStep<N, TmdDevice> {
   using D = FixedFrameData<M>;
   static const M& frame(const M& m) { return m; }
   static const D& frame(const D& d) { return d; }
+  static D& frame(D& d) { return d; }
   // x0, v0: the TMD's initial displacement and speed [Ld, Vd].
   static void init(const M& m, D& d, typename M::Q x0, typename M::Q v0, typename M::Q a0) {
     fixed_tmd_init(m, d, x0, v0, a0);
@@ -59,11 +61,18 @@ struct DeviceStep<N, VinesDevice<L>> {
   using D = FixedVinesData<M>;
   static const typename M::Frame& frame(const M& m) { return m.frame; }
   static const FixedFrameData<typename M::Frame>& frame(const D& d) { return d.frame; }
+  static FixedFrameData<typename M::Frame>& frame(D& d) { return d.frame; }
   // v0: the particle's initial speed [Vp].
   static void init(const M& m, D& d, typename M::Q /*x0*/, typename M::Q v0, typename M::Q a0) {
     fixed_vines_init(m, d, v0, a0);
   }
   static void step(const M& m, D& d, typename M::Q a1) { fixed_vines_step(m, d, a1); }
+};
+
+// A TMD keeps no fixed-point energy ledger (its state is not modal).
+struct NoLedger {
+  bool on = false;
+  double unit = 0;
 };
 
 // The block: what the host builds (build_node_model, below), the image
@@ -75,9 +84,11 @@ struct NodeModel {
   using D = typename Step::D;
   using Q = typename M::Q;
   static constexpr int kNx = 2 * M::kP;
+  static constexpr bool kLedger = Dev::kKind != DeviceKind::kTmd;  // a modal frame's (fixed/ledger.hpp)
 
   M step;
   FixedReadout<N, kNx> read;
+  std::conditional_t<kLedger, FixedLedger<M::kP>, NoLedger> ledger;
   double h = 0;          // the sensor step [s]
   int split_steps = 0;   // the scene's loop.split_steps the step was built with
   Q x0 = Q(0), v0 = Q(0);  // initial conditions: a TMD's displacement and speed, a particle's speed
@@ -113,43 +124,96 @@ struct SampleHold {
   }
 };
 
-// At rest (a TMD or the particle at its initial conditions) on the first
-// sample a0; one sensor step to the sample a1.
+// The VI NES's contact at the step's end: the law's force on the particle,
+// positive to the right (the double model's contact_force), and its
+// elastic part [F_u]; the overlap [D]. All 0 with none (or no VI NES).
+template <typename Q>
+struct ContactEnd {
+  Q force = Q(0), elastic = Q(0), depth = Q(0);
+};
+
 template <int N, typename Dev>
-void node_init(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a0) {
-  NodeModel<N, Dev>::Step::init(nm.step, d, nm.x0, nm.v0, a0);
-}
-template <int N, typename Dev>
-void node_step(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a1) {
-  NodeModel<N, Dev>::Step::step(nm.step, d, a1);
+ContactEnd<typename NodeModel<N, Dev>::Q> contact_end(const NodeModel<N, Dev>& nm,
+                                                      const typename NodeModel<N, Dev>::D& d) {
+  using Q = typename NodeModel<N, Dev>::Q;
+  ContactEnd<Q> c;
+  if constexpr (Dev::kKind == DeviceKind::kVines) {
+    constexpr int P = NodeModel<N, Dev>::M::kP;
+    if (d.side == 0) return c;
+    const auto& m = nm.step;
+    const Q vf = gain_dot<Q>(m.dev_v, d.frame.z.template tail<P>());
+    c.depth = d.overlap * m.to_overlap;
+    const Q q = numeric::sqrt(numeric::sqrt(c.depth));
+    const Q u = Q(d.side) * (d.sd - vf) * m.to_speed;
+    const contact::Force<Q> f = m.law[0].regular(q, u);
+    c.elastic = f.elastic;
+    c.force = d.side > 0 ? -f.total() : f.total();
+  }
+  return c;
 }
 
-// The VI NES's contact force on the particle at the step's end, positive to
-// the right (the double model's contact_force), in the readout's unit F_u:
-// the law's kernel in the contact's units at the overlap and its rate.
-template <int N, ContactLaw L>
-numeric::Fixed<kFixedBits> contact_force(const NodeModel<N, VinesDevice<L>>& nm,
-                                         const typename NodeModel<N, VinesDevice<L>>::D& d) {
-  using Q = numeric::Fixed<kFixedBits>;
-  constexpr int P = NodeModel<N, VinesDevice<L>>::M::kP;
-  if (d.side == 0) return Q(0);
-  const auto& m = nm.step;
-  const Q vf = gain_dot<Q>(m.dev_v, d.frame.z.template tail<P>());
-  const Q q = numeric::sqrt(numeric::sqrt(d.overlap * m.to_overlap));
-  const Q u = Q(d.side) * (d.sd - vf) * m.to_speed;
-  const Q f = m.law[0].regular(q, u).total();
-  return d.side > 0 ? -f : f;
+template <int N, typename Dev>
+numeric::Fixed<kFixedBits> contact_force(const NodeModel<N, Dev>& nm, const typename NodeModel<N, Dev>::D& d) {
+  return contact_end(nm, d).force;
+}
+
+// At rest (a TMD or the particle at its initial conditions) on the first
+// sample a0; the energy ledger opened when the model keeps one.
+template <int N, typename Dev>
+void node_init(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a0) {
+  using NM = NodeModel<N, Dev>;
+  NM::Step::init(nm.step, d, nm.x0, nm.v0, a0);
+  if constexpr (NM::kLedger) {
+    if (!nm.ledger.on) return;
+    auto& fd = NM::Step::frame(d);
+    typename NM::Q sd(0);
+    if constexpr (Dev::kKind == DeviceKind::kVines) sd = d.sd;
+    ledger_init(nm.ledger, fd.ledger, fd.z, sd);
+  }
+}
+
+// One sensor step to the sample a1; with the energy ledger, its work over
+// the step (the modes' and the particle's, between the contact's forces at
+// the step's ends) and the balance at its end.
+template <int N, typename Dev>
+void node_step(const NodeModel<N, Dev>& nm, typename NodeModel<N, Dev>::D& d, typename NodeModel<N, Dev>::Q a1) {
+  using NM = NodeModel<N, Dev>;
+  using Q = typename NM::Q;
+  if constexpr (NM::kLedger) {
+    if (nm.ledger.on) {
+      auto& fd = NM::Step::frame(d);
+      const auto z0 = fd.z;  // a copy: the step moves fd.z
+      const Q a0 = fd.a_prev;
+      const ContactEnd<Q> c0 = contact_end(nm, d);
+      Q sd0(0);
+      if constexpr (Dev::kKind == DeviceKind::kVines) sd0 = d.sd;
+      NM::Step::step(nm.step, d, a1);
+      const ContactEnd<Q> c1 = contact_end(nm, d);
+      ledger_modes_step(nm.ledger, fd.ledger, z0, fd.z, a0, a1, -c0.force, -c1.force);
+      Q sd1(0);
+      numeric::Wide<kLedgerBits> lost;
+      if constexpr (Dev::kKind == DeviceKind::kVines) {
+        sd1 = d.sd;
+        lost = d.lost;
+        ledger_particle_step(nm.ledger, fd.ledger, sd0, sd1, a0, a1, c0.force, c1.force);
+      }
+      ledger_close(nm.ledger, fd.ledger, fd.z, sd1, c1.elastic, c1.depth, lost);
+      return;
+    }
+  }
+  NM::Step::step(nm.step, d, a1);
 }
 
 // What a node reports of its state, read as the board and the host both
 // read it (the board's telemetry, the host engine's snapshot): the floors
 // and the top floor's acceleration from the readout, E_e, and for a VI NES
 // the particle, the contact force (on the particle, positive to the right)
-// and the contact's mode.
+// and the contact's mode; with the energy ledger, the energy the contacts
+// dissipated.
 template <int N>
 struct NodeReading {
   double x[N] = {};
-  double acc_top = 0, elastic_energy = 0, particle_x = 0, particle_v = 0, contact_force = 0;
+  double acc_top = 0, elastic_energy = 0, particle_x = 0, particle_v = 0, contact_force = 0, dissipated = 0;
   Mode mode = Mode::kFree;
 };
 
@@ -170,6 +234,7 @@ NodeReading<N> read_node(const NodeModel<N, Dev>& nm, const typename NodeModel<N
   }
   r.acc_top = top_acceleration(nm.read, fd.z, force);
   r.elastic_energy = static_cast<double>(fd.ee) * NM::Step::frame(nm.step).ee_unit;
+  if (nm.ledger.on) r.dissipated = static_cast<double>(fd.ledger.contact) * nm.ledger.unit;
   return r;
 }
 
@@ -209,6 +274,12 @@ void build_node_model(const Model<double, N, Dev>& m, const FixedParams& f, Node
       to_z(j, j) = fr.sq(j);
       to_z(DP + j, P + j) = fr.sv(j);
     }
+    ParticleUnits pu;
+    if constexpr (Dev::kKind == DeviceKind::kVines) {
+      const ContactUnits& u = nm.step.cu.u;
+      pu = {u.m, nm.step.speed, u.force(), u.m * u.v * u.v};
+    }
+    nm.ledger = build_fixed_ledger<P>(m, fr.sq, fr.sv, fr.sa, pu);
   }
   nm.read = build_readout<N, Dev, NX>(m, to_z, f_unit);
 }

@@ -22,6 +22,7 @@
 
 #include "vines/fixed/contact_step.hpp"
 #include "vines/fixed/forced_contact.hpp"
+#include "vines/fixed/ledger.hpp"
 #include "vines/fixed/vines_model.hpp"
 #include "vines/numeric/fixed_math.hpp"
 #include "vines/numeric/hermite.hpp"
@@ -40,6 +41,7 @@ struct FixedVinesData {
   // Contacts counted, events (starts and ends), capped integrations, sensor
   // steps with a contact in them, Runge-Kutta steps in all and in the worst.
   std::uint32_t contacts = 0, events = 0, capped = 0, careful = 0, contact_steps = 0, max_contact_steps = 0;
+  numeric::Wide<kLedgerBits> lost;  // the energy lost in contacts [m V^2] (fixed/ledger.hpp)
 };
 
 // The state at rest with the particle at its start moving at v0 [Vp] and
@@ -173,6 +175,8 @@ void fixed_vines_step(const M& m, FixedVinesData<M>& d, typename M::Q a1) {
     d.contact_steps += static_cast<std::uint32_t>(fc.steps);
     if (static_cast<std::uint32_t>(fc.steps) > d.max_contact_steps) d.max_contact_steps = fc.steps;
     if (fc.capped) ++d.capped;
+    d.lost += numeric::Wide<kLedgerBits>::from_raw(  // y's unit m V^2 2^-10n, to 40 bits
+        wide_product(fc.y(K + 3), numeric::Gain::pow2(kLedgerBits - Q::kFractionBits - 10 * n)));
 
     // 4. The step's end.
     // Each mode takes its moments' terms summed 64 bits wide, rounded and

@@ -69,6 +69,7 @@ class FixedPlant {
     t->particle_v = r.particle_v;
     t->contact_force = r.contact_force;
     t->contact_mode = static_cast<std::uint8_t>(r.mode);
+    t->dissipated = r.dissipated;
     // A held sample or a saturation: the run is degraded from here.
     const std::uint32_t guards = hold_.held + (numeric::fixed_saturations() - saturations_);
     if (guards != guard_events_) t->flags |= kGuard;
@@ -96,7 +97,7 @@ class FixedPlant {
     }
     if (!(std::fabs(model_->h * c.scene.loop.sensor_rate_hz - 1.0) <= 1e-12))
       return "loop.sensor_rate_hz: differs from the model image's";
-    if (c.scene.loop.energy_ledger) return "loop.energy_ledger: not kept in fixed point yet";
+    if (c.scene.loop.energy_ledger != model_->ledger.on) return "loop.energy_ledger: differs from the model image's";
     return nullptr;
   }
 

@@ -75,6 +75,40 @@ class Gain {
     return x * g;
   }
 
+  // A 64-bit raw value x (any format) times g, in x's format: the 94-bit
+  // product in two 32 x 32 halves (no 128-bit type on a Cortex-M), rounded
+  // to nearest; beyond +-2^62 held there and counted as a saturation. For
+  // the wide sums of the energy ledger (fixed/ledger.hpp): a product of two
+  // Fixed, exact in 64 bits, scaled once.
+  friend std::int64_t wide_times(std::int64_t x, Gain g) {
+    constexpr std::uint64_t kHeld = std::uint64_t{1} << 62;
+    if (x == 0 || g.mant_ == 0) return 0;
+    const bool negative = (x < 0) != (g.mant_ < 0);
+    const std::uint64_t ax = x < 0 ? 0 - static_cast<std::uint64_t>(x) : static_cast<std::uint64_t>(x);
+    const std::uint64_t am = static_cast<std::uint64_t>(g.mant_ < 0 ? -std::int64_t{g.mant_} : g.mant_);
+    const std::uint64_t lo = (ax & 0xffffffffu) * am, hi = (ax >> 32) * am;  // x m = hi 2^32 + lo, each < 2^62
+    const int shift = 30 - g.exp_;
+    std::uint64_t r = kHeld;
+    if (shift >= 96) {
+      r = 0;
+    } else if (shift > 32) {  // floor((hi + 2^(shift-33)) + lo / 2^32) / 2^(shift-32)): rounded
+      const int s = shift - 32;
+      r = (hi + (lo >> 32) + (std::uint64_t{1} << (s - 1))) >> s;
+    } else if (shift > 0) {
+      const int up = 32 - shift;  // hi 2^up + (lo + 2^(shift-1)) 2^-shift
+      if (hi < (kHeld >> up)) r = (hi << up) + ((lo + (std::uint64_t{1} << (shift - 1))) >> shift);
+    } else if (-shift <= 62) {  // hi 2^(32+up) + lo 2^up, each below 2^62
+      const int up = -shift;
+      const bool hi_fits = up < 30 ? hi < (kHeld >> (32 + up)) : hi == 0;
+      if (hi_fits && lo < (kHeld >> up)) r = (hi == 0 ? 0 : hi << (32 + up)) + (lo << up);
+    }
+    if (r >= kHeld) {
+      r = kHeld;
+      ++fixed_saturations();
+    }
+    return negative ? -static_cast<std::int64_t>(r) : static_cast<std::int64_t>(r);
+  }
+
  private:
   std::int32_t mant_ = 0;
   int exp_ = 0;
