@@ -158,6 +158,44 @@ TEST(Studies, FixedPointIcGridMatchesDouble) {
   }
 }
 
+// El Centro in fixed point against double over 20 draws a law (the sphere's
+// initial speed in (0, 1e-4] m/s): each draw's peak within 1e-4, the means
+// of x_r, E_r and the contact count as close as the issue asks. One draw's
+// E_r is not: a pair's difference spreads by 0.8 to 1.5 points, as double's
+// own does under such perturbations (docs/fixed_point.md).
+TEST(Studies, FixedPointElCentroDrawsMatchDouble) {
+  const Sweep sw("fixed_point_elcentro.toml");
+  ASSERT_EQ(sw.spec.studies.size(), 6u);
+  for (int s = 0; s < 6; s += 2) {
+    const auto d = sw.by(s, "vines.initial_velocity_mps"), f = sw.by(s + 1, "vines.initial_velocity_mps");
+    ASSERT_EQ(d.size(), 40u);
+    ASSERT_EQ(f.size(), d.size());
+    std::vector<double> xr[2], er[2], contacts[2];
+    double worst_peak = 0;
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      ASSERT_EQ(d[i].first, f[i].first);
+      EXPECT_FALSE(f[i].second.degraded) << f[i].second.degraded_reasons;
+      worst_peak = std::fmax(worst_peak, std::fabs(f[i].second.peak_top / d[i].second.peak_top - 1.0));
+      for (int k = 0; k < 2; ++k) {
+        const RunResult& r = (k ? f : d)[i].second;
+        xr[k].push_back(r.x_r);
+        er[k].push_back(r.E_r);
+        contacts[k].push_back(static_cast<double>(r.contacts));
+      }
+    }
+    const char* name = sw.spec.studies[s + 1].name.c_str();
+    std::printf("%s: peaks within %.2e; x_r %.4f %% +- %.4f (double %.4f +- %.4f), E_r %.3f %% +- %.3f (double "
+                "%.3f +- %.3f), contacts %.2f (%.2f)\n",
+                name, worst_peak, 100 * mean(xr[1]), 100 * sd(xr[1]), 100 * mean(xr[0]), 100 * sd(xr[0]),
+                100 * mean(er[1]), 100 * sd(er[1]), 100 * mean(er[0]), 100 * sd(er[0]), mean(contacts[1]),
+                mean(contacts[0]));
+    EXPECT_LT(worst_peak, 1e-4) << name;
+    EXPECT_NEAR(mean(xr[1]), mean(xr[0]), 1e-3) << name;
+    EXPECT_NEAR(mean(er[1]), mean(er[0]), 5e-3) << name;
+    EXPECT_NEAR(mean(contacts[1]), mean(contacts[0]), 0.1 * mean(contacts[0])) << name;
+  }
+}
+
 TEST(Studies, DamageHurtsTheTmdNotTheVines) {
   const Sweep sw("damage.toml");
   bool tmd_negative = false;
