@@ -1,11 +1,14 @@
 // Shared by the scene tests (test_scene*.cpp): the shipped scenes' folder, a
-// valid VI NES scene to edit, and the refusal of a scene text.
+// valid VI NES scene to edit, a shipped scene's text with loop lines added,
+// and the refusal of a scene text.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
+#include <sstream>
 #include <string>
 
 #include "sim_host/scene/scene.hpp"
@@ -32,6 +35,17 @@ kind = "vines"
 [record]
 path = "elcentro_1940_ns_2688pts_dt002_time_g.dat"
 )";
+
+// A shipped scene's text with `loop_lines` put first in its [loop] table.
+inline std::string shipped_scene_with(const std::string& file, const std::string& loop_lines) {
+  std::ifstream in(kScenes + file);
+  std::stringstream all;
+  all << in.rdbuf();
+  std::string text = all.str();
+  const auto at = text.find("[loop]\n");
+  EXPECT_NE(at, std::string::npos) << file;
+  return at == std::string::npos ? text : text.insert(at + 7, loop_lines);
+}
 
 // The SceneError message of parsing `text` ("" if it parses).
 inline std::string error_of(const std::string& text) {

@@ -11,8 +11,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include <Eigen/LU>
@@ -20,6 +18,7 @@
 #include "sim_host/engines/model_builders.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/scene.hpp"
+#include "scene_support.hpp"
 #include "support.hpp"
 #include "vines/fixed/tmd.hpp"
 
@@ -31,17 +30,11 @@ namespace {
 
 using namespace vines::host;
 
-const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+using vines::scene_test::kScenes;
 
 // A shipped scene's text with [loop] lines put first in its [loop] table.
 std::string scene_text(const std::string& file, const std::string& loop_lines) {
-  std::ifstream in(kScenes + file);
-  std::stringstream all;
-  all << in.rdbuf();
-  std::string text = all.str();
-  const auto at = text.find("[loop]\n");
-  EXPECT_NE(at, std::string::npos) << file;
-  return text.insert(at + 7, loop_lines);
+  return vines::scene_test::shipped_scene_with(file, loop_lines);
 }
 
 // `vines run` of the scene with the loop lines, nothing written.

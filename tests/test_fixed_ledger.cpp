@@ -8,12 +8,11 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/scene.hpp"
+#include "scene_support.hpp"
 #include "support.hpp"
 
 namespace {
@@ -21,18 +20,11 @@ namespace {
 using namespace vines;
 using namespace vines::host;
 
-const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+using scene_test::kScenes;
 
 // A shipped scene (its energy_ledger = true) with loop lines put first.
 RunReport run_with(const std::string& file, const std::string& loop_lines) {
-  std::ifstream in(kScenes + file);
-  std::stringstream all;
-  all << in.rdbuf();
-  std::string text = all.str();
-  const auto at = text.find("[loop]\n");
-  EXPECT_NE(at, std::string::npos) << file;
-  text.insert(at + 7, loop_lines);
-  const Scene scene = parse_scene(text, kScenes + file);
+  const Scene scene = parse_scene(scene_test::shipped_scene_with(file, loop_lines), kScenes + file);
   EXPECT_TRUE(scene.params.loop.energy_ledger) << file;
   return run_scene(scene, RunOptions{});
 }

@@ -106,11 +106,12 @@ ContactState<S, K> contact_rate(const Law& law, const ContactCoupling<S, K, R>& 
   d(0) = u * scale;
   d(1) = j * (g - floor_response(c, y, r) - force * c.inv_m_star);
   d(2) = j;
-  // mu_k' = F (h - t)^k / k!, each term from the last.
+  // mu_k' = F (h - t)^k / k!, each term from the last (none past the last:
+  // in fixed point a product and a division of every rate).
   S term = j * force;
   for (int k = 0; k < K; ++k) {
     d(3 + k) = term;
-    term = over(term * r, k + 1);
+    if (k + 1 < K) term = over(term * r, k + 1);
   }
   d(K + 3) = j * f.dissipative * u;
   return d;
