@@ -104,7 +104,7 @@ class EngineImpl final : public Engine {
     }
     r.peak_top = static_cast<double>(d.peak_top);
     r.peak_x[N - 1] = r.peak_x[N - 1] > r.peak_top ? r.peak_x[N - 1] : r.peak_top;
-    r.t_peak_top = d.t_peak_top;
+    r.t_peak_top = peak_top_time(*model_, d);
     r.peak_top_velocity = static_cast<double>(d.peak_top_velocity);
     r.elastic_energy = elastic_energy(*model_, d);
     r.strain_increments = d.strain_increments.wide();

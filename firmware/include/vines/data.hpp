@@ -88,10 +88,12 @@ struct Carry {
   // The top floor and the device floor now.
   S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
   std::int64_t k = 0;  // samples consumed; the state is at t = k h
-  // Running maxima of the top floor: |x| continuous in time (reached at
-  // t_peak_top), |v| at the samples.
+  // Running maxima of the top floor: |x| continuous in time, |v| at the
+  // samples. |x| is reached peak_top_dt [s] into the step from sample
+  // peak_top_k: read the time with peak_top_time(m, d) (sim.hpp), in double.
   S peak_top = S(0), peak_top_velocity = S(0);
-  double t_peak_top = 0;
+  std::int64_t peak_top_k = 0;
+  S peak_top_dt = S(0);
   // E_e = integral of (1/2) x^T K x dt [J s] is ee_sum, less V(z) while a run
   // of exact steps is open (ee_open; see lyapunov_split): read it with
   // elastic_energy(m, d). A compensated sum in S (numeric/compensated.hpp).

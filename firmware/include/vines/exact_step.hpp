@@ -243,7 +243,8 @@ VINES_NOINLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, const 
   const S peak = top_peak_of_step(m, z0, z1, a0, a1, c.xt, c.vt, r.xt, r.vt, c.peak_top);
   if (VINES_UNLIKELY(peak > c.peak_top)) {
     c.peak_top = peak;
-    c.t_peak_top = static_cast<double>(c.k) * m.h + m.h;
+    c.peak_top_k = c.k;
+    c.peak_top_dt = m.period;
   }
   c.xt = r.xt;
   c.vt = r.vt;

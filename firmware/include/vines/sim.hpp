@@ -272,6 +272,15 @@ double elastic_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
   return d.ee_open ? ee - static_cast<double>(m.ee_boundary.eval(d.z, S(0))) : ee;
 }
 
+// When the top floor's |x| reached its running peak [s], in double: the
+// sample's time plus the time into its step (a whole step: the next
+// sample's, k h + h).
+template <typename S, int N, typename Dev>
+double peak_top_time(const Model<S, N, Dev>& m, const Carry<S>& d) {
+  const double dt = d.peak_top_dt == m.period ? m.h : static_cast<double>(d.peak_top_dt);
+  return static_cast<double>(d.peak_top_k) * m.h + dt;
+}
+
 // The energy ledger in double (vines::Ledger), as the host reads it.
 template <typename S, int N, typename Dev>
 Ledger energy_ledger(const Data<S, N, Dev>& d) {

@@ -170,12 +170,12 @@ struct SubStepper {
 
 }  // namespace detail
 
-// Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending at t1
-// within the run): peaks (per floor too, if floors and the loop keeps
+// Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending t1
+// into the sensor step): peaks (per floor too, if floors and the loop keeps
 // them), contact depth.
 template <typename S, int N, typename Dev, typename Vec>
 void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0, const Vec& y1, S h,
-                   double t1, bool floors = true) {
+                   S t1, bool floors = true) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   const auto z0 = y0.template head<NX>();
   const auto z1 = y1.template head<NX>();
