@@ -36,7 +36,7 @@ namespace detail {
 template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_bounded(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
                                 S vprobe) {
-  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  const S limit = m.divergence_limit;
   if (!(bound + (vprobe - vprobe) <= limit)) return false;
   if constexpr (Dev::kKind == DeviceKind::kTmd) return std::fabs(z(N)) <= limit;
   return true;
@@ -45,7 +45,7 @@ template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
                                  S vprobe) {
   if (VINES_LIKELY(frame_bounded(m, z, bound, vprobe))) return false;
-  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  const S limit = m.divergence_limit;
   if (!std::isfinite(bound + vprobe)) return true;  // bound >= 0: an infinity stays one
   if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
@@ -57,7 +57,7 @@ template <typename S, int N, typename Dev>
 bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
   if (frame_diverged(m, z, m.floor_bound(z), z.template tail<Model<S, N, Dev>::kP>().sum())) return true;
   if constexpr (Dev::kKind == DeviceKind::kVines) {
-    const S r = s - xf, radius = static_cast<S>(m.dev.design.radius);
+    const S r = s - xf, radius = m.dev.radius;
     if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(sd)) return true;
   }
   return false;

@@ -296,7 +296,7 @@ namespace detail {
 // The relative tolerance of contacts that the scalar can honour.
 template <typename S, int N, typename Dev>
 S contact_rtol(const Model<S, N, Dev>& m) {
-  return std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
+  return m.contact_rtol;
 }
 
 // An event due before any time passes (due_event), applied (apply_event):
