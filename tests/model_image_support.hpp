@@ -104,7 +104,8 @@ const char* first_difference(const Model<S, N, Dev>& ma, const Data<S, N, Dev>& 
   VINES_SAME(k);
   VINES_SAME(peak_top);
   VINES_SAME(peak_top_velocity);
-  VINES_SAME(t_peak_top);
+  VINES_SAME(peak_top_k);
+  VINES_SAME(peak_top_dt);
   VINES_SAME(ee_sum);
   VINES_SAME(ee_open);
   VINES_SAME(a_prev);

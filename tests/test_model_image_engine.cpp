@@ -108,7 +108,7 @@ TEST(ModelImageCli, WritesTheImageOfAScene) {
   std::string text;
   ASSERT_EQ(vines_cli("image " + scene_file("elcentro_vines.toml") + " --out " + out, &text), 0) << text;
   EXPECT_NE(text.find(std::to_string(image::image_bytes<double, 10, Kuwabara>()) +
-                      " bytes, version 2, double, 10 stories, vines (kuwabara), CRC 0x"),
+                      " bytes, version 3, double, 10 stories, vines (kuwabara), CRC 0x"),
             std::string::npos)
       << text;
   // The file is the engine's image, and loads.
@@ -119,7 +119,7 @@ TEST(ModelImageCli, WritesTheImageOfAScene) {
 
   ASSERT_EQ(vines_cli("image " + scene_file("elcentro_tmd.toml") + " --scalar float --out " + out, &text), 0) << text;
   EXPECT_NE(text.find(std::to_string(image::image_bytes<float, 10, TmdDevice>()) +
-                      " bytes, version 2, float, 10 stories, tmd, CRC 0x"),
+                      " bytes, version 3, float, 10 stories, tmd, CRC 0x"),
             std::string::npos)
       << text;
   EXPECT_EQ(read_file(out).size(), (image::image_bytes<float, 10, TmdDevice>()));

@@ -79,7 +79,7 @@ void check_corruption_refused(DeviceKind kind) {
   // Another version (header patched: the check comes before the CRC).
   Bytes v2 = img;
   v2[4] = 1;
-  EXPECT_EQ(load(f.ld, v2, 7), "model image: version 1, this node reads 2");
+  EXPECT_EQ(load(f.ld, v2, 7), "model image: version 1, this node reads 3");
   // Not an image at all.
   Bytes junk(img.size(), 0x42);
   EXPECT_EQ(load(f.ld, junk, 256), "model image: not a model image (no VNMI magic)");

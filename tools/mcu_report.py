@@ -6,7 +6,8 @@ conditions, per contact scheme; flash and RAM (arm-none-eabi-size); stack
 -fcallgraph-info=su); the highest sensor rate the worst step sustains.
 
   tools/mcu_report.py [--vines PATH] [--targets cortex-m4f,cortex-m7,cortex-m3]
-                      [--schemes adaptive,bounded [--bounded-substeps N]]
+                      [--schemes adaptive,bounded,split [--bounded-substeps N]
+                      [--split-steps N]]
                       [--quick] [--duration S] [--full-scene] [--records GLOB]
                       [--only scene,records,ics,tmd,bare,twin_vines,twin_tmd,twin_bare]
                       [--keep-scenes DIR]
@@ -42,7 +43,9 @@ written and the build's own scheme runs. With --schemes each listed scheme
 is a mode: [loop] contact_scheme = "NAME" is written in the VI NES scenes
 (and bounded_substeps = N for "bounded" when --bounded-substeps is given);
 a build that refuses the key reports that mode's runs as failed, with
-vines' message.
+vines' message. --split-steps N writes [loop] split_steps = N for the split
+scheme (and the fixed-point board's, whose default is 16; the scene's
+default is 64).
 
 Figures, per target and mode (VI NES image, that mode's runs):
   instructions_per_step_max     max over runs of worst_step_instructions (the
@@ -117,6 +120,7 @@ def main():
     ap.add_argument("--schemes", help="contact schemes, one mode each (e.g. adaptive,bounded); "
                                       "default: the build's own, no key written")
     ap.add_argument("--bounded-substeps", type=int, help="[loop] bounded_substeps for the bounded scheme")
+    ap.add_argument("--split-steps", type=int, help="[loop] split_steps for the split scheme")
     ap.add_argument("--quick", action="store_true", help="El Centro scene only, 3 s (or --duration)")
     ap.add_argument("--duration", type=float, help="cap every run at S seconds of record")
     ap.add_argument("--full-scene", action="store_true", help="the El Centro scene run is not capped")
@@ -151,6 +155,8 @@ def main():
         raise Failure("-j must be >= 1")
     if a.bounded_substeps is not None and a.bounded_substeps < 1:
         raise Failure("--bounded-substeps must be >= 1")
+    if a.split_steps is not None and a.split_steps < 1:
+        raise Failure("--split-steps must be >= 1")
 
     vines = a.vines if os.path.isabs(a.vines) or os.path.exists(a.vines) else os.path.join(ROOT, a.vines)
     if not (os.path.isfile(vines) and os.access(vines, os.X_OK)):

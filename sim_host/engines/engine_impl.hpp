@@ -85,7 +85,7 @@ class EngineImpl final : public Engine {
     const Data<S, N, Dev>& d = *data_;
     Probe p;
     p.count = d.count;
-    p.ledger = d.ledger;
+    p.ledger = energy_ledger(d);
     p.peak_top = static_cast<double>(d.peak_top);
     if constexpr (Dev::kKind == DeviceKind::kVines) {
       const S r = d.s - d.xf;
@@ -104,12 +104,12 @@ class EngineImpl final : public Engine {
     }
     r.peak_top = static_cast<double>(d.peak_top);
     r.peak_x[N - 1] = r.peak_x[N - 1] > r.peak_top ? r.peak_x[N - 1] : r.peak_top;
-    r.t_peak_top = d.t_peak_top;
+    r.t_peak_top = peak_top_time(*model_, d);
     r.peak_top_velocity = static_cast<double>(d.peak_top_velocity);
     r.elastic_energy = elastic_energy(*model_, d);
-    r.strain_increments = d.strain_increments;
+    r.strain_increments = d.strain_increments.wide();
     r.max_overlap = static_cast<double>(d.max_overlap);
-    r.ledger = d.ledger;
+    r.ledger = energy_ledger(d);
     r.count = d.count;
     return r;
   }

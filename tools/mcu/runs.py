@@ -38,7 +38,8 @@ def plan(a, tmp, records_dir):
 
     for target in a.targets:
         for mode in modes:
-            vs = lambda: base_scene("elcentro_vines.toml", target, records_dir, mode, a.bounded_substeps)
+            vs = lambda: base_scene("elcentro_vines.toml", target, records_dir, mode, a.bounded_substeps,
+                                  a.split_steps)
             scene_rec = os.path.basename(vs()["record"]["path"])
             if "scene" in kinds:
                 add(target, mode, "scene", vs(), scene_rec, SCENE_IC, None if a.full_scene else cap)

@@ -66,7 +66,7 @@ def resolve_record(path, records_dir):
     return path  # left to vines' own search (and its error)
 
 
-def base_scene(name, target, records_dir, scheme=None, bounded_substeps=None):
+def base_scene(name, target, records_dir, scheme=None, bounded_substeps=None, split_steps=None):
     """A shipped scene at the target's rate and scalar, output trimmed."""
     _, scalar, rate, _ = TARGETS[target]
     sc = load_toml(os.path.join(SCENES, name))
@@ -79,6 +79,8 @@ def base_scene(name, target, records_dir, scheme=None, bounded_substeps=None):
         loop["contact_scheme"] = scheme
         if scheme == "bounded" and bounded_substeps is not None:
             loop["bounded_substeps"] = bounded_substeps
+    if split_steps is not None and (scheme == "split" or (scheme is None and scalar == "fixed")):
+        loop["split_steps"] = split_steps
     if scalar == "fixed":
         fixed_point(loop, scheme)
     sc["output"] = {"rate_hz": rate, "timeseries": False}

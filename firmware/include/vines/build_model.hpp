@@ -76,6 +76,8 @@ ParamError build_frames(const SceneParams& p, Model<S, N, Dev>& md) {
   md.loop = p.loop;
   md.h = 1.0 / p.loop.sensor_rate_hz;
   md.period = static_cast<S>(md.h);
+  md.divergence_limit = static_cast<S>(p.loop.divergence_limit_m);
+  md.contact_rtol = std::fmax(static_cast<S>(p.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
   md.floor = p.device.floor > 0 ? p.device.floor - 1 : N - 1;
 
   // Rayleigh damping fitted on two modes, zeta(w) = a0 / (2w) + a1 w / 2, goes
@@ -229,6 +231,7 @@ ParamError build_vines(const VinesParams& vp, double device_mass, Model<S, N, De
   dm.m_star = static_cast<S>(d.m_star);
   dm.c = static_cast<S>(d.c);
   dm.eps = static_cast<S>(d.eps);
+  dm.radius = static_cast<S>(d.radius);
   dm.law = LawOf<Dev::kLaw>::template kernel<S>(d);
   const double v_scale = vp.v_ref_mps > 0.0 ? vp.v_ref_mps : 0.5;
   dm.pos_scale = static_cast<S>(contact::hertz_max_overlap(d.mass, d.c, v_scale));

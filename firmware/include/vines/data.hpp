@@ -8,10 +8,13 @@
 
 #include "vines/contact_mode.hpp"
 #include "vines/model.hpp"
+#include "vines/numeric/compensated.hpp"
 
 namespace vines {
 
-// Energy ledger [J], accumulated in double whatever the loop's scalar.
+// Energy ledger [J] as the host reads it (sim_host's RunTotals and Probe,
+// the link's telemetry): in double whatever the loop's scalar. The loop
+// keeps its own in its scalar (StepLedger below); ledger_of() reads it.
 struct Ledger {
   double initial = 0;     // stored at t = 0 (initial conditions): energy put in too
   double input = 0;       // work of the inertial loads -m a_g on every mass
@@ -25,6 +28,39 @@ struct Ledger {
   double max_input = 0;   // largest of initial + input and stored + dissipated so far
   double relative_residual() const { return max_input > 0 ? max_abs_residual / max_input : 0; }
 };
+
+// The energy ledger a loop keeps, in its scalar S: the same quantities as
+// Ledger, the three work sums over the record compensated
+// (numeric/compensated.hpp: in double the plain sums, in float a float pair
+// each), so that a float loop keeps them to about a double sum's accuracy
+// with no double arithmetic on its step.
+template <typename S>
+struct StepLedger {
+  S initial = S(0);
+  numeric::Sum<S> input, damping, contact;
+  S kinetic = S(0), strain = S(0), device = S(0);
+  S residual = S(0);
+  S max_abs_residual = S(0);
+  S max_input = S(0);
+  S relative_residual() const { return max_input > S(0) ? max_abs_residual / max_input : S(0); }
+};
+
+// The ledger in double, as the host reads it.
+template <typename S>
+Ledger ledger_of(const StepLedger<S>& l) {
+  Ledger o;
+  o.initial = static_cast<double>(l.initial);
+  o.input = l.input.wide();
+  o.damping = l.damping.wide();
+  o.contact = l.contact.wide();
+  o.kinetic = static_cast<double>(l.kinetic);
+  o.strain = static_cast<double>(l.strain);
+  o.device = static_cast<double>(l.device);
+  o.residual = static_cast<double>(l.residual);
+  o.max_abs_residual = static_cast<double>(l.max_abs_residual);
+  o.max_input = static_cast<double>(l.max_input);
+  return o;
+}
 
 struct Counters {
   std::int64_t steps = 0;
@@ -52,14 +88,16 @@ struct Carry {
   // The top floor and the device floor now.
   S xt = S(0), vt = S(0), xf = S(0), vf = S(0);
   std::int64_t k = 0;  // samples consumed; the state is at t = k h
-  // Running maxima of the top floor: |x| continuous in time (reached at
-  // t_peak_top), |v| at the samples.
+  // Running maxima of the top floor: |x| continuous in time, |v| at the
+  // samples. |x| is reached peak_top_dt [s] into the step from sample
+  // peak_top_k: read the time with peak_top_time(m, d) (sim.hpp), in double.
   S peak_top = S(0), peak_top_velocity = S(0);
-  double t_peak_top = 0;
+  std::int64_t peak_top_k = 0;
+  S peak_top_dt = S(0);
   // E_e = integral of (1/2) x^T K x dt [J s] is ee_sum, less V(z) while a run
   // of exact steps is open (ee_open; see lyapunov_split): read it with
-  // elastic_energy(m, d).
-  double ee_sum = 0;
+  // elastic_energy(m, d). A compensated sum in S (numeric/compensated.hpp).
+  numeric::Sum<S> ee_sum;
   bool ee_open = false;
 };
 
@@ -82,11 +120,12 @@ struct Data : Carry<S> {
   // Running maxima per floor (continuous in time, not just samples), only
   // with loop.floor_peaks; the top floor's are in Carry.
   VecN peak_x = VecN::Zero(), peak_drift = VecN::Zero();
-  double strain_increments = 0;  // sum of positive increments of the strain energy [J] (floor_peaks)
-  double last_strain = 0;
-  Ledger ledger;
+  numeric::Sum<S> strain_increments;  // sum of positive increments of the strain energy [J] (floor_peaks)
+  S last_strain = S(0);
+  StepLedger<S> ledger;
   Counters count;
 
+  // The time now [s], in double (off the step: outputs).
   double time(const M& m) const { return static_cast<double>(this->k) * m.h; }
 };
 

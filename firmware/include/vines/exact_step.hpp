@@ -36,7 +36,7 @@ namespace detail {
 template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_bounded(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
                                 S vprobe) {
-  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  const S limit = m.divergence_limit;
   if (!(bound + (vprobe - vprobe) <= limit)) return false;
   if constexpr (Dev::kKind == DeviceKind::kTmd) return std::fabs(z(N)) <= limit;
   return true;
@@ -45,7 +45,7 @@ template <typename S, int N, typename Dev>
 VINES_INLINE bool frame_diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S bound,
                                  S vprobe) {
   if (VINES_LIKELY(frame_bounded(m, z, bound, vprobe))) return false;
-  const S limit = static_cast<S>(m.loop.divergence_limit_m);
+  const S limit = m.divergence_limit;
   if (!std::isfinite(bound + vprobe)) return true;  // bound >= 0: an infinity stays one
   if (bound > limit && !(m.floor_x(z).cwiseAbs().maxCoeff() <= limit)) return true;
   if constexpr (Dev::kKind == DeviceKind::kTmd) {
@@ -57,7 +57,7 @@ template <typename S, int N, typename Dev>
 bool diverged(const Model<S, N, Dev>& m, const typename Model<S, N, Dev>::VecX& z, S xf, S s, S sd) {
   if (frame_diverged(m, z, m.floor_bound(z), z.template tail<Model<S, N, Dev>::kP>().sum())) return true;
   if constexpr (Dev::kKind == DeviceKind::kVines) {
-    const S r = s - xf, radius = static_cast<S>(m.dev.design.radius);
+    const S r = s - xf, radius = m.dev.radius;
     if (!(r >= m.dev.wall_left - radius && r <= m.dev.wall_right + radius) || !std::isfinite(sd)) return true;
   }
   return false;
@@ -111,12 +111,12 @@ VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Carry<S>& d, const
                                    const StepRead<S>& r, S a0, S a1) {
   if (m.ee_lyapunov) {
     if (VINES_UNLIKELY(!d.ee_open)) {
-      d.ee_sum += static_cast<double>(m.ee_boundary.eval(z, S(0)));
+      d.ee_sum.add(m.ee_boundary.eval(z, S(0)));
       d.ee_open = true;
     }
-    d.ee_sum += static_cast<double>(r.lin);
+    d.ee_sum.add(r.lin);
   } else {
-    d.ee_sum += static_cast<double>(m.strain_step.eval(z, a0, a1));
+    d.ee_sum.add(m.strain_step.eval(z, a0, a1));
   }
 }
 
@@ -124,7 +124,7 @@ VINES_INLINE void add_elastic_step(const Model<S, N, Dev>& m, Carry<S>& d, const
 template <typename S, int N, typename Dev>
 void close_elastic_run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
   if (!d.ee_open) return;
-  d.ee_sum -= static_cast<double>(m.ee_boundary.eval(d.z, S(0)));
+  d.ee_sum.sub(m.ee_boundary.eval(d.z, S(0)));
   d.ee_open = false;
 }
 
@@ -183,7 +183,7 @@ VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typ
     S s, sd, r, rd, ax, av;
   };
   S vpeak = c.peak_top_velocity;
-  double ee = c.ee_sum;
+  numeric::Sum<S> ee = c.ee_sum;
   // Step i from a to b; false (b untouched) if step i is not plain.
   auto advance = [&](const Hand& a, Hand& b, int i) {
     const StepRead<S>& r = rs[i];
@@ -197,7 +197,7 @@ VINES_NOINLINE int plain_steps(const Model<S, N, Dev>& m, Carry<S>& c, const typ
     b.ax = std::fabs(r.xt);
     b.av = std::fabs(r.vt);
     if (abs_bound(a.ax, a.av, b.ax, b.av, h) > peak) return false;
-    ee += static_cast<double>(r.lin);
+    ee.add(r.lin);
     vpeak = numeric::max_of(vpeak, b.av);
     return true;
   };
@@ -243,7 +243,8 @@ VINES_NOINLINE Exact finish_exact(const Model<S, N, Dev>& m, Carry<S>& c, const 
   const S peak = top_peak_of_step(m, z0, z1, a0, a1, c.xt, c.vt, r.xt, r.vt, c.peak_top);
   if (VINES_UNLIKELY(peak > c.peak_top)) {
     c.peak_top = peak;
-    c.t_peak_top = static_cast<double>(c.k) * m.h + m.h;
+    c.peak_top_k = c.k;
+    c.peak_top_dt = m.period;
   }
   c.xt = r.xt;
   c.vt = r.vt;
@@ -262,9 +263,9 @@ template <typename S, int N, typename Dev>
 void keep_extras(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typename Model<S, N, Dev>::VecX& z1, S a0,
                  S a1, S sd0) {
   if (m.loop.energy_ledger) {
-    d.ledger.input += static_cast<double>(m.input_step.eval(d.z, a0, a1));
-    d.ledger.damping += static_cast<double>(m.damping_step.eval(d.z, a0, a1));
-    if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input -= free_flight_work(m, sd0, a0, a1);
+    d.ledger.input.add(m.input_step.eval(d.z, a0, a1));
+    d.ledger.damping.add(m.damping_step.eval(d.z, a0, a1));
+    if constexpr (Dev::kKind == DeviceKind::kVines) d.ledger.input.sub(free_flight_work(m, sd0, a0, a1));
   }
   if (m.loop.floor_peaks)
     update_peaks<S, N>(m.floor_x(d.z), m.floor_v(d.z), m.floor_x(z1), m.floor_v(z1), m.period, d.peak_x, d.peak_drift);

@@ -85,6 +85,8 @@ struct DeviceModel<S, VinesDevice<L>> {
   // A free step stays clear of the walls while s - x_f stays inside
   // (clear_lo, clear_hi): the walls widened by event_tol.
   S event_tol, round_tol, clear_lo, clear_hi;
+  // The sphere's radius [m] in S (the divergence check's margin beyond a wall).
+  S radius;
 };
 
 template <typename S, int N, typename Dev>
@@ -109,6 +111,12 @@ struct Model {
   double h = 0;          // sensor period [s]
   int floor = N - 1;     // device floor, 0-based
   S period = S(0);       // h in S
+  // The loop's settings the step reads, in S (no conversion from double on
+  // the step: on a single-precision FPU that is a library call):
+  // loop.divergence_limit_m, and loop.contact_rtol no finer than the scalar
+  // honours (64 eps).
+  S divergence_limit = S(0);
+  S contact_rtol = S(0);
 
   // Exact step and exact step integrals of the linear part.
   LtiT lti;

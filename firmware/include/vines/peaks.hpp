@@ -62,15 +62,17 @@ VINES_INLINE S top_peak_of_step(const Model<S, N, Dev>& m, const typename Model<
   return numeric::quintic_abs_max(x0, v0, m.top_a(z0, a0), x1, v1, m.top_a(z1, a1), m.period);
 }
 
-// Peak of the top floor over a sub-step of length h (cubic Hermite).
+// Peak of the top floor over a sub-step of length h (cubic Hermite) that
+// ends t1 into the sensor step.
 template <typename S, int N, typename Dev>
-void update_top_peak_cubic(Data<S, N, Dev>& d, S x0, S v0, S x1, S v1, S h, double t1) {
+void update_top_peak_cubic(Data<S, N, Dev>& d, S x0, S v0, S x1, S v1, S h, S t1) {
   if (top_bound(x0, v0, x1, v1, h) <= d.peak_top) return;
   const S p = std::fmax(numeric::Cubic<S>::make(x0, v0, x1, v1, h).max_value(),
                         numeric::Cubic<S>::make(-x0, -v0, -x1, -v1, h).max_value());
   if (p > d.peak_top) {
     d.peak_top = p;
-    d.t_peak_top = t1;
+    d.peak_top_k = d.k;
+    d.peak_top_dt = t1;
   }
 }
 

@@ -37,22 +37,25 @@ namespace vines {
 
 namespace detail {
 
-// Stored energies now and the balance residual.
+// Stored energies now and the balance residual, in S (the work sums read
+// to S: in float the residual is good to a float's rounding of the energies,
+// ~1e-7 of them).
 template <typename S, int N, typename Dev>
 void close_ledger(const Model<S, N, Dev>& m, Data<S, N, Dev>& d) {
-  Ledger& l = d.ledger;
-  l.kinetic = static_cast<double>(m.kinetic.eval(d.z, S(0)));
-  l.strain = static_cast<double>(m.strain.eval(d.z, S(0)));
-  l.device = static_cast<double>(m.device_potential.eval(d.z, S(0)));
+  StepLedger<S>& l = d.ledger;
+  l.kinetic = m.kinetic.eval(d.z, S(0));
+  l.strain = m.strain.eval(d.z, S(0));
+  l.device = m.device_potential.eval(d.z, S(0));
   if constexpr (Dev::kKind == DeviceKind::kVines) {
-    l.kinetic += 0.5 * static_cast<double>(m.dev.m * d.sd * d.sd);
-    l.device += static_cast<double>(contact_energy(m, d));
+    l.kinetic += S(0.5) * (m.dev.m * d.sd * d.sd);
+    l.device += contact_energy(m, d);
   }
-  const double dissipated = l.damping + l.contact;
-  const double stored = l.kinetic + l.strain + l.device;
-  l.residual = l.initial + l.input - stored - dissipated;
+  const S input = l.input.value();
+  const S dissipated = l.damping.value() + l.contact.value();
+  const S stored = l.kinetic + l.strain + l.device;
+  l.residual = l.initial + input - stored - dissipated;
   l.max_abs_residual = std::fmax(l.max_abs_residual, std::fabs(l.residual));
-  l.max_input = std::fmax(l.max_input, std::fmax(l.initial + l.input, stored + dissipated));
+  l.max_input = std::fmax(l.max_input, std::fmax(l.initial + input, stored + dissipated));
 }
 
 // The top floor and the device floor from the state.
@@ -93,7 +96,7 @@ void init(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0) {
     d.ledger.max_abs_residual = 0;
     detail::close_ledger(m, d);
   }
-  d.last_strain = static_cast<double>(m.strain.eval(d.z, S(0)));
+  d.last_strain = m.strain.eval(d.z, S(0));
 }
 
 namespace detail {
@@ -169,8 +172,8 @@ VINES_INLINE void end_of_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a
   d.a_prev = a1;
   ++d.count.steps;
   if (m.loop.floor_peaks) {
-    const double strain_now = static_cast<double>(m.strain.eval(d.z, S(0)));
-    if (strain_now > d.last_strain) d.strain_increments += strain_now - d.last_strain;
+    const S strain_now = m.strain.eval(d.z, S(0));
+    if (strain_now > d.last_strain) d.strain_increments.add(strain_now - d.last_strain);
     d.last_strain = strain_now;
   }
   if (m.loop.energy_ledger) close_ledger(m, d);
@@ -262,10 +265,26 @@ void run(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const T* a, std::size_t 
   }
 }
 
-// E_e so far [J s].
+// E_e so far [J s], in double (off the step: an output).
 template <typename S, int N, typename Dev>
 double elastic_energy(const Model<S, N, Dev>& m, const Data<S, N, Dev>& d) {
-  return d.ee_open ? d.ee_sum - static_cast<double>(m.ee_boundary.eval(d.z, S(0))) : d.ee_sum;
+  const double ee = d.ee_sum.wide();
+  return d.ee_open ? ee - static_cast<double>(m.ee_boundary.eval(d.z, S(0))) : ee;
+}
+
+// When the top floor's |x| reached its running peak [s], in double: the
+// sample's time plus the time into its step (a whole step: the next
+// sample's, k h + h).
+template <typename S, int N, typename Dev>
+double peak_top_time(const Model<S, N, Dev>& m, const Carry<S>& d) {
+  const double dt = d.peak_top_dt == m.period ? m.h : static_cast<double>(d.peak_top_dt);
+  return static_cast<double>(d.peak_top_k) * m.h + dt;
+}
+
+// The energy ledger in double (vines::Ledger), as the host reads it.
+template <typename S, int N, typename Dev>
+Ledger energy_ledger(const Data<S, N, Dev>& d) {
+  return ledger_of(d.ledger);
 }
 
 // Floor displacements and velocities now (outputs only).

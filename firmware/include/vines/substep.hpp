@@ -105,7 +105,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
       S tau;
       const auto rr = detail::locate_event(m, st, u, y, f, r, du, h, theta, side, rtol, &tau);
       // Accept up to the event.
-      track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), d.time(m) + static_cast<double>(rr.y(kT)));
+      track_substep(m, d, st.mode, y, rr.y, rr.y(kT) - y(kT), rr.y(kT));
       u += tau;
       y = rr.y;
       ++d.count.substeps;
@@ -122,7 +122,7 @@ void substep_through(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     }
 
     // Plain accepted sub-step.
-    track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), d.time(m) + static_cast<double>(r.y(kT)));
+    track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), r.y(kT));
     u += du;
     y = r.y;
     f = r.f;

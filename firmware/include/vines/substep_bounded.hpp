@@ -202,7 +202,7 @@ Vec interpolate_to(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, con
                    const Vec& y1, const Vec& f1, S du, S theta) {
   constexpr int kT = Model<S, N, Dev>::kNx + 6;
   const Vec y = numeric::hermite_point(y0, f0, y1, f1, du, theta);
-  track_substep(m, d, mode, y0, y, y(kT) - y0(kT), d.time(m) + static_cast<double>(y(kT)), false);
+  track_substep(m, d, mode, y0, y, y(kT) - y0(kT), y(kT), false);
   return y;
 }
 
@@ -258,7 +258,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     const Vec y0 = y;
     if (!st.regular()) y += (h - y(kT)) * f;
     y(kT) = h;
-    track_substep(m, d, st.mode, y0, y, h - y0(kT), d.time(m) + static_cast<double>(h), false);
+    track_substep(m, d, st.mode, y0, y, h - y0(kT), h, false);
   };
 
   while (y(kT) < h) {
@@ -323,7 +323,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
     if (any) short_of_budget = true;  // an event that waits for the next step
 
     // 5. The whole sub-step.
-    track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), d.time(m) + static_cast<double>(r.y(kT)), false);
+    track_substep(m, d, st.mode, y, r.y, r.y(kT) - y(kT), r.y(kT), false);
     const Vec y0 = y, f0 = f;
     y = r.y;
     f = r.f;
@@ -342,7 +342,7 @@ void substep_bounded(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) 
           const Vec y1 = y;
           y = numeric::hermite_point(y0, f0, y1, f, du, th);
           y(kT) = h;
-          track_substep(m, d, st.mode, y1, y, h - y1(kT), d.time(m) + static_cast<double>(h), false);
+          track_substep(m, d, st.mode, y1, y, h - y1(kT), h, false);
         } else {
           finish_without_substep();
         }

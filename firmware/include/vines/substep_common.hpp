@@ -43,12 +43,12 @@ VINES_INLINE void free_flight(const Model<S, N, Dev>& m, S s, S sd, S a0, S a1, 
 // Work of the particle's inertial load over that step: -m integral a v dt,
 // a = a0 + al t, v = v0 - a0 t - al t^2 / 2.
 template <typename S, int N, typename Dev>
-double free_flight_work(const Model<S, N, Dev>& m, S v0, S a0, S a1) {
+S free_flight_work(const Model<S, N, Dev>& m, S v0, S a0, S a1) {
   const S h = m.period, al = (a1 - a0) / h;
   const S h2 = h * h, h3 = h2 * h, h4 = h3 * h;
   const S w = a0 * v0 * h - a0 * a0 * h2 / S(2) - a0 * al * h3 / S(6) + al * v0 * h2 / S(2) -
               al * a0 * h3 / S(3) - al * al * h4 / S(8);
-  return static_cast<double>(m.dev.m * w);
+  return m.dev.m * w;
 }
 
 namespace detail {
@@ -170,12 +170,12 @@ struct SubStepper {
 
 }  // namespace detail
 
-// Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending at t1
-// within the run): peaks (per floor too, if floors and the loop keeps
+// Bookkeeping of an accepted sub-step from y0 to y1 (length h, ending t1
+// into the sensor step): peaks (per floor too, if floors and the loop keeps
 // them), contact depth.
 template <typename S, int N, typename Dev, typename Vec>
 void track_substep(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, Mode mode, const Vec& y0, const Vec& y1, S h,
-                   double t1, bool floors = true) {
+                   S t1, bool floors = true) {
   constexpr int NX = Model<S, N, Dev>::kNx;
   const auto z0 = y0.template head<NX>();
   const auto z1 = y1.template head<NX>();
@@ -296,7 +296,7 @@ namespace detail {
 // The relative tolerance of contacts that the scalar can honour.
 template <typename S, int N, typename Dev>
 S contact_rtol(const Model<S, N, Dev>& m) {
-  return std::fmax(static_cast<S>(m.loop.contact_rtol), S(64) * std::numeric_limits<S>::epsilon());
+  return m.contact_rtol;
 }
 
 // An event due before any time passes (due_event), applied (apply_event):
@@ -349,10 +349,10 @@ void store_state(Data<S, N, Dev>& d, const Stepper& st, const Vec& y) {
   d.s = y(NX);
   d.sd = y(NX + 1);
   d.q = st.regular() ? y(Stepper::kQ) : S(0);
-  d.ledger.contact += static_cast<double>(y(NX + 2));
-  d.ledger.input += static_cast<double>(y(NX + 3));
-  d.ledger.damping += static_cast<double>(y(NX + 4));
-  d.ee_sum += static_cast<double>(y(NX + 5));
+  d.ledger.contact.add(y(NX + 2));
+  d.ledger.input.add(y(NX + 3));
+  d.ledger.damping.add(y(NX + 4));
+  d.ee_sum.add(y(NX + 5));
   S fp, loss;
   st.force(y, &fp, &loss);
   d.contact_force = fp;

@@ -157,10 +157,10 @@ void split_integrals(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typena
       damping += weights[i] * m.damping_power.eval(z, a);
     }
   }
-  d.ee_sum += static_cast<double>(ee * h);
+  d.ee_sum.add(ee * h);
   if (m.loop.energy_ledger) {
-    d.ledger.input += static_cast<double>(input * h);
-    d.ledger.damping += static_cast<double>(damping * h);
+    d.ledger.input.add(input * h);
+    d.ledger.damping.add(damping * h);
   }
 }
 
@@ -173,7 +173,8 @@ void commit_free_step(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, const typen
   const S peak = top_peak_of_step(m, d.z, z1, a0, a1, d.xt, d.vt, r.xt, r.vt, d.peak_top);
   if (peak > d.peak_top) {
     d.peak_top = peak;
-    d.t_peak_top = d.time(m) + m.h;
+    d.peak_top_k = d.k;
+    d.peak_top_dt = m.period;
   }
   keep_extras(m, d, z1, a0, a1, d.sd);
   d.z = z1;
@@ -269,8 +270,8 @@ void substep_split(const Model<S, N, Dev>& m, Data<S, N, Dev>& d, S a0, S a1) {
   const VecX f0 = m.lti.derivative(z0, a0, sg * f_start), f1 = m.lti.derivative(z, a1, sg * f_end);
   detail::split_integrals(m, d, z0, f0, z, f1, d.sd, -a0 - sg * f_start * dm.inv_m, sd_end,
                           -a1 - sg * f_end * dm.inv_m, a0, a1);
-  if (m.loop.energy_ledger) d.ledger.contact += static_cast<double>(fc.y(K + 3));
-  detail::update_top_peak_cubic(d, m.top_x(z0), m.top_v(z0), m.top_x(z), m.top_v(z), h, d.time(m) + m.h);
+  if (m.loop.energy_ledger) d.ledger.contact.add(fc.y(K + 3));
+  detail::update_top_peak_cubic(d, m.top_x(z0), m.top_v(z0), m.top_x(z), m.top_v(z), h, h);
   if (m.loop.floor_peaks)
     detail::update_peaks<S, N>(m.floor_x(z0), m.floor_v(z0), m.floor_x(z), m.floor_v(z), h, d.peak_x,
                                d.peak_drift);

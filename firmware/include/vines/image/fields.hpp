@@ -56,6 +56,8 @@ constexpr void visit_fields(V& v) {
   v(all, &M::h);
   v(all, &M::floor);
   v(all, &M::period);
+  v(all, &M::divergence_limit);
+  v(all, &M::contact_rtol);
 
   // Exact step of the linear part.
   if constexpr (M::kModal) {
@@ -122,14 +124,14 @@ constexpr void visit_fields(V& v) {
     Law::coefficients([&](auto coefficient) { v(all, &M::dev, &DM::law, coefficient); });
     for (auto f : {&DM::pos_scale, &DM::vel_scale, &DM::modal_scale, &DM::q_scale, &DM::w_step0, &DM::ff_a0,
                    &DM::ff_a1, &DM::ff_v, &DM::count_depth, &DM::event_tol, &DM::round_tol, &DM::clear_lo,
-                   &DM::clear_hi})
+                   &DM::clear_hi, &DM::radius})
       v(all, &M::dev, f);
     // New DeviceModel fields of the VI NES here, one line each:
     //   v(all, &M::dev, &DM::new_field);
     // Tripwire, as for LoopParams (a field small enough to hide in the end
     // padding of one scalar shows in the other).
-    static_assert(sizeof(DM) == (offsetof(DM, clear_hi) + sizeof(S) + alignof(DM) - 1) / alignof(DM) * alignof(DM),
-                  "DeviceModel (VI NES) has a field after clear_hi: add its line to visit_fields");
+    static_assert(sizeof(DM) == (offsetof(DM, radius) + sizeof(S) + alignof(DM) - 1) / alignof(DM) * alignof(DM),
+                  "DeviceModel (VI NES) has a field after radius: add its line to visit_fields");
   }
 }
 

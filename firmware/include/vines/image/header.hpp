@@ -14,7 +14,7 @@
 
 namespace vines::image {
 
-inline constexpr std::uint16_t kVersion = 2;  // 2: loop.split_steps
+inline constexpr std::uint16_t kVersion = 3;  // 2: loop.split_steps; 3: the loop's limits and the radius in S
 inline constexpr std::size_t kHeaderBytes = 28;
 inline constexpr std::uint8_t kMagic[4] = {'V', 'N', 'M', 'I'};
 inline constexpr std::uint8_t kNoLaw = 0xFF;

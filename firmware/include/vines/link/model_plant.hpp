@@ -113,7 +113,7 @@ class ModelPlant {
       t->contact_force = static_cast<double>(d.contact_force);
       t->contact_mode = static_cast<std::uint8_t>(d.mode);
     }
-    t->dissipated = d.ledger.contact;
+    t->dissipated = d.ledger.contact.wide();
     const std::int64_t guards = d.count.bad_samples + d.count.divergences;
     if (guards != guard_events_) t->flags |= kGuard;
     guard_events_ = guards;
