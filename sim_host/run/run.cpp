@@ -11,6 +11,7 @@
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/io/csv.hpp"
+#include "sim_host/io/npy.hpp"
 #include "sim_host/io/digest.hpp"
 #include "sim_host/io/output.hpp"
 #include "sim_host/run/drive.hpp"
@@ -90,36 +91,62 @@ json device_json(DeviceKind kind, const ModelInfo& info) {
   return dp;
 }
 
-void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
-  CsvWriter csv(file.string());
-  const int n = dev.info.stories;
-  const DeviceKind kind = scene.params.device.kind;
-  // Header: time, ground, per-floor quantities, E_e, the device's state, the bare frame's.
-  csv.raw("t_s").raw("ag_mps2");
+// The timeseries' columns: time, ground, per-floor quantities, E_e, the
+// device's state, the bare frame's; contact_mode is an integer.
+std::vector<NpyField> timeseries_columns(const Scene& scene, int n, bool bare) {
+  std::vector<NpyField> c{{"t_s"}, {"ag_mps2"}};
   for (const char* q : {"x", "v", "acc", "drift"})
     for (int i = 1; i <= n; ++i)
-      csv.raw(q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2"));
-  csv.raw("Ee_Js");
+      c.push_back({q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2")});
+  c.push_back({"Ee_Js"});
+  const DeviceKind kind = scene.params.device.kind;
+  if (kind == DeviceKind::kVines) {
+    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n"})
+      c.push_back({h});
+    c.push_back({"contact_mode", true});
+  }
+  if (kind == DeviceKind::kTmd) c.insert(c.end(), {{"tmd_x_m"}, {"tmd_v_mps"}});
+  if (bare) c.insert(c.end(), {{"bare_x_top_m"}, {"bare_Ee_Js"}});
+  return c;
+}
+
+// Row r's values in the columns' order.
+void timeseries_row(const Scene& scene, const Trace& dev, const Trace* bare, std::size_t r, std::vector<double>* v) {
+  const int n = dev.info.stories;
+  const Snapshot& s = dev.rows[r];
+  v->clear();
+  v->insert(v->end(), {s.t, s.ag});
+  for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift}) v->insert(v->end(), a->begin(), a->begin() + n);
+  v->push_back(s.elastic_energy);
+  const DeviceKind kind = scene.params.device.kind;
   if (kind == DeviceKind::kVines)
-    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n", "contact_mode"})
-      csv.raw(h);
-  if (kind == DeviceKind::kTmd) csv.raw("tmd_x_m").raw("tmd_v_mps");
-  if (bare) csv.raw("bare_x_top_m").raw("bare_Ee_Js");
-  csv.end_row();
-  // One row per snapshot: time to the microsecond, the rest to 9 digits.
-  constexpr const char* kValue = "%.9g";
-  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
-    const Snapshot& s = dev.rows[r];
-    csv.number(s.t, "%.6f").number(s.ag, kValue);
-    for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift})
-      for (int i = 0; i < n; ++i) csv.number((*a)[i], kValue);
-    csv.number(s.elastic_energy, kValue);
-    if (kind == DeviceKind::kVines) {
-      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) csv.number(v, kValue);
-      csv.integer(s.mode);
+    v->insert(v->end(), {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force,
+                         static_cast<double>(s.mode)});
+  if (kind == DeviceKind::kTmd) v->insert(v->end(), {s.tmd_x, s.tmd_v});
+  if (bare) v->insert(v->end(), {bare->rows[r].x[n - 1], bare->rows[r].elastic_energy});
+}
+
+// timeseries.csv (every number in its shortest exact form) or
+// timeseries.npy: the same columns, values bit for bit either way.
+void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
+  const std::vector<NpyField> cols = timeseries_columns(scene, dev.info.stories, bare != nullptr);
+  std::vector<double> v;
+  if (scene.output.format == TimeseriesFormat::kNpy) {
+    NpyWriter npy(file.string(), cols, dev.rows.size());
+    for (std::size_t r = 0; r < dev.rows.size(); ++r) {
+      timeseries_row(scene, dev, bare, r, &v);
+      npy.row(v.data());
     }
-    if (kind == DeviceKind::kTmd) csv.number(s.tmd_x, kValue).number(s.tmd_v, kValue);
-    if (bare) csv.number(bare->rows[r].x[n - 1], kValue).number(bare->rows[r].elastic_energy, kValue);
+    npy.close();
+    return;
+  }
+  CsvWriter csv(file.string());
+  for (const NpyField& c : cols) csv.raw(c.name);
+  csv.end_row();
+  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
+    timeseries_row(scene, dev, bare, r, &v);
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      cols[i].integer ? csv.integer(std::llround(v[i])) : csv.exact(v[i]);
     csv.end_row();
   }
   csv.close();
@@ -201,7 +228,8 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
     d.add(scene.path);
     d.add_file(scene.path);
     d.add_file(ex.record.path);
-    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv"}, d.hex());
+    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv", "timeseries.npy"},
+                d.hex());
   }
 
   // The device run, and with a device the bare frame on the same samples.
@@ -225,13 +253,14 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
   r.wall_s = dev.wall_s;
   r.status = device_status(r.totals, r.bare ? &*r.bare : nullptr, p, r.info, r.scalar);
 
-  // The run's folder: timeseries.csv, then summary.json (the file that says the
-  // run is complete) last; a timeseries.csv of an earlier run is removed.
+  // The run's folder: the timeseries, then summary.json (the file that says the
+  // run is complete) last; a timeseries of an earlier run is removed.
   if (out) {
     std::vector<std::string> written{"summary.json"};
     if (series) {
-      write_timeseries(out->file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
-      written.push_back("timeseries.csv");
+      const char* name = scene.output.format == TimeseriesFormat::kNpy ? "timeseries.npy" : "timeseries.csv";
+      write_timeseries(out->file(name), scene, dev, has_device ? &bare : nullptr);
+      written.push_back(name);
     }
     write_file_atomic(out->file("summary.json"), r.to_json().dump(2) + '\n');
     out->finish(written);
