@@ -25,21 +25,56 @@ using nlohmann::json;
 
 std::vector<double> head(const FloorArray& a, int n) { return {a.begin(), a.begin() + n}; }
 
-// One engine run over the samples; snapshots every `every` steps.
+// What a run keeps every `every` steps: its snapshots (RunReport::series),
+// and the timeseries' values (a device run: its columns; the bare frame's
+// beside it: its top floor and E_e), each row `width` doubles.
+struct Keep {
+  bool snapshots = false;
+  int width = 0;  // 0: no values
+  bool bare = false;
+};
+
 struct Trace {
   RunTotals totals;
   ModelInfo info;
   std::vector<Snapshot> rows;
+  std::vector<double> values;  // rows of Keep::width
   double wall_s = 0;
 };
 
-Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
+// A snapshot's values in the timeseries' columns (the device's), or the
+// bare frame's two.
+void append_values(const Snapshot& s, int n, DeviceKind kind, bool bare, std::vector<double>* v) {
+  if (bare) {
+    v->insert(v->end(), {s.x[n - 1], s.elastic_energy});
+    return;
+  }
+  v->insert(v->end(), {s.t, s.ag});
+  for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift}) v->insert(v->end(), a->begin(), a->begin() + n);
+  v->push_back(s.elastic_energy);
+  if (kind == DeviceKind::kVines)
+    v->insert(v->end(), {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force,
+                         static_cast<double>(s.mode)});
+  if (kind == DeviceKind::kTmd) v->insert(v->end(), {s.tmd_x, s.tmd_v});
+}
+
+// One engine run over the samples, keeping what `keep` asks every `every` steps.
+Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every, const Keep& keep) {
   std::unique_ptr<Engine> eng = build_engine(p, scene.scalar, scene.path);
   Trace tr;
   tr.info = eng->info();
+  // Every row's room at once: no copies as they grow.
+  const std::size_t rows = every > 0 ? ex.samples.size() / static_cast<std::size_t>(every) + 2 : 0;
+  if (keep.snapshots) tr.rows.reserve(rows);
+  tr.values.reserve(rows * static_cast<std::size_t>(keep.width));
+  const int n = tr.info.stories;
   const auto t0 = std::chrono::steady_clock::now();
   hal::RecordSource src(ex.samples, ex.rate_hz);
-  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) { tr.rows.push_back(eng->snapshot()); });
+  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) {
+    const Snapshot s = eng->snapshot();
+    if (keep.width > 0) append_values(s, n, p.device.kind, keep.bare, &tr.values);
+    if (keep.snapshots) tr.rows.push_back(s);
+  });
   tr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   tr.totals = eng->totals();
   return tr;
@@ -110,31 +145,21 @@ std::vector<NpyField> timeseries_columns(const Scene& scene, int n, bool bare) {
   return c;
 }
 
-// Row r's values in the columns' order.
-void timeseries_row(const Scene& scene, const Trace& dev, const Trace* bare, std::size_t r, std::vector<double>* v) {
-  const int n = dev.info.stories;
-  const Snapshot& s = dev.rows[r];
-  v->clear();
-  v->insert(v->end(), {s.t, s.ag});
-  for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift}) v->insert(v->end(), a->begin(), a->begin() + n);
-  v->push_back(s.elastic_energy);
-  const DeviceKind kind = scene.params.device.kind;
-  if (kind == DeviceKind::kVines)
-    v->insert(v->end(), {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force,
-                         static_cast<double>(s.mode)});
-  if (kind == DeviceKind::kTmd) v->insert(v->end(), {s.tmd_x, s.tmd_v});
-  if (bare) v->insert(v->end(), {bare->rows[r].x[n - 1], bare->rows[r].elastic_energy});
-}
-
 // timeseries.csv (every number in its shortest exact form) or
-// timeseries.npy: the same columns, values bit for bit either way.
+// timeseries.npy: the same columns, values bit for bit either way. A row is
+// the device run's values, then the bare frame's.
 void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
   const std::vector<NpyField> cols = timeseries_columns(scene, dev.info.stories, bare != nullptr);
-  std::vector<double> v;
+  const std::size_t width = cols.size() - (bare ? 2 : 0), rows = dev.values.size() / width;
+  std::vector<double> v(cols.size());
+  auto row = [&](std::size_t r) {
+    std::copy_n(dev.values.begin() + static_cast<std::ptrdiff_t>(r * width), width, v.begin());
+    if (bare) std::copy_n(bare->values.begin() + static_cast<std::ptrdiff_t>(2 * r), 2, v.begin() + width);
+  };
   if (scene.output.format == TimeseriesFormat::kNpy) {
-    NpyWriter npy(file.string(), cols, dev.rows.size());
-    for (std::size_t r = 0; r < dev.rows.size(); ++r) {
-      timeseries_row(scene, dev, bare, r, &v);
+    NpyWriter npy(file.string(), cols, rows);
+    for (std::size_t r = 0; r < rows; ++r) {
+      row(r);
       npy.row(v.data());
     }
     npy.close();
@@ -143,8 +168,8 @@ void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev
   CsvWriter csv(file.string());
   for (const NpyField& c : cols) csv.raw(c.name);
   csv.end_row();
-  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
-    timeseries_row(scene, dev, bare, r, &v);
+  for (std::size_t r = 0; r < rows; ++r) {
+    row(r);
     for (std::size_t i = 0; i < cols.size(); ++i)
       cols[i].integer ? csv.integer(std::llround(v[i])) : csv.exact(v[i]);
     csv.end_row();
@@ -233,12 +258,13 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
   }
 
   // The device run, and with a device the bare frame on the same samples.
-  const Trace dev = run_engine(scene, p, ex, every);
+  const int width = series ? static_cast<int>(timeseries_columns(scene, p.frame.stories, false).size()) : 0;
+  const Trace dev = run_engine(scene, p, ex, every, Keep{opt.keep_series, width, false});
   Trace bare;
   if (has_device) {
     SceneParams pb = p;
     pb.device.kind = DeviceKind::kNone;
-    bare = run_engine(scene, pb, ex, every);
+    bare = run_engine(scene, pb, ex, every, Keep{opt.keep_series, series ? 2 : 0, true});
   }
   RunReport r;
   r.scene = scene.name;
