@@ -11,8 +11,8 @@
 #include "sim_host/io/csv.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/studies/bench.hpp"
-#include "sim_host/studies/bench_ensemble.hpp"
+#include "sim_host/bench/bench.hpp"
+#include "sim_host/bench/ensemble.hpp"
 #include "vines/params.hpp"
 
 namespace vines::cli {

@@ -1,4 +1,4 @@
-#include "sim_host/studies/bench.hpp"
+#include "sim_host/bench/bench.hpp"
 
 #include <algorithm>
 #include <chrono>

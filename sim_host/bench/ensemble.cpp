@@ -1,4 +1,4 @@
-#include "sim_host/studies/bench_ensemble.hpp"
+#include "sim_host/bench/ensemble.hpp"
 
 #include <algorithm>
 #include <chrono>

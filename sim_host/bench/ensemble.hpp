@@ -13,7 +13,7 @@
 
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/studies/bench.hpp"
+#include "sim_host/bench/bench.hpp"
 
 namespace vines::host {
 
