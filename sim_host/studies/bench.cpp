@@ -120,9 +120,11 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
 
 reference::Method baseline_method(const std::string& name) {
   if (name == "dop853") return reference::Method::kDop853;
+  if (name == "dop853-driver") return reference::Method::kDop853Driver;
   if (name == "cvode-adams") return reference::Method::kCvodeAdams;
   if (name == "cvode-bdf") return reference::Method::kCvodeBdf;
-  throw std::runtime_error("--baseline-methods: unknown method '" + name + "' (dop853, cvode-adams, cvode-bdf)");
+  throw std::runtime_error("--baseline-methods: unknown method '" + name +
+                           "' (dop853, dop853-driver, cvode-adams, cvode-bdf)");
 }
 
 // One baseline line (DOP853 in double or CVODE) on the record's own points.
@@ -157,7 +159,7 @@ BenchLine baseline_line(const Scene& base, const std::string& method, double rto
 
 }  // namespace
 
-const char* const kBaselineMethods[3] = {"dop853", "cvode-adams", "cvode-bdf"};
+const char* const kBaselineMethods[4] = {"dop853", "dop853-driver", "cvode-adams", "cvode-bdf"};
 
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);

@@ -71,7 +71,7 @@ struct BenchOptions {
 };
 
 // The baseline methods by name, in table order.
-extern const char* const kBaselineMethods[3];
+extern const char* const kBaselineMethods[4];
 
 // The scene's reference, or an unknown truth if there is none on file.
 Truth load_truth(const Scene& scene, const std::string& reference_dir);
