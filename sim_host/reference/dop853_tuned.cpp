@@ -100,6 +100,15 @@ Bracket locate(const Poly& p, double lo, double hi, double sign, double tol) {
   return {lo, hi};
 }
 
+// How far the cubic Hermite interpolant on [0, len] (values g0, g1, slopes
+// d0, d1) can stray from its chord: a quarter of the largest departure of
+// the end slopes from the chord's. Skips the stationary points when no
+// hidden root is possible.
+double hermite_bulge(double g0, double d0, double g1, double d1, double len) {
+  const double chord = g1 - g0;
+  return 0.25 * std::max(std::fabs(d0 * len - chord), std::fabs(d1 * len - chord));
+}
+
 // The run on a frame of F floors with D device slots (F = 0: any, the
 // state's size from the spec, up to kMaxSize).
 template <int F, int D>
@@ -150,20 +159,23 @@ class TunedRun {
   }
 
  private:
-  // An affine function of the state, w.y + c (an event function, a monitor).
+  // An affine function of the state (an event function, a monitor):
+  // c + sum_k w_k y[at_k] over its n non-zero weights.
   struct Affine {
-    Vec w{};
+    int n = 0;
+    std::array<int, kCap> at{};
+    std::array<double, kCap> w{};
     double c = 0;
   };
   int size() const { return N > 0 ? N : n_; }
-  double dot(const Vec& w, const Vec& y) const {
+  static double dot(const Affine& g, const Vec& y) {
     double s = 0.0;
-    for (int q = 0; q < size(); ++q) s += w[q] * y[q];
+    for (int k = 0; k < g.n; ++k) s += g.w[k] * y[g.at[k]];
     return s;
   }
-  double at(const Affine& g, const Vec& y) const { return dot(g.w, y) + g.c; }
+  static double at(const Affine& g, const Vec& y) { return dot(g, y) + g.c; }
   // Its time derivative along f, times h.
-  double rate(const Affine& g, const Vec& f, double h) const { return h * dot(g.w, f); }
+  static double rate(const Affine& g, const Vec& f, double h) { return h * dot(g, f); }
   // The weights of a linear function of the state, probed at the unit vectors.
   template <class L>
   Affine linear(L f) const {
@@ -171,7 +183,7 @@ class TunedRun {
     Vec e{};
     for (int q = 0; q < size(); ++q) {
       e[q] = 1.0;
-      g.w[q] = f(e.data());
+      if (const double w = f(e.data()); w != 0.0) g.at[g.n] = q, g.w[g.n++] = w;
       e[q] = 0.0;
     }
     return g;
@@ -257,7 +269,7 @@ class TunedRun {
   Poly along(const Affine& g) {
     dense();
     Poly p;
-    for (int i = 0; i < 8; ++i) p.c[i] = dot(g.w, r_[i]);
+    for (int i = 0; i < 8; ++i) p.c[i] = dot(g, r_[i]);
     p.c[0] += g.c;
     return p;
   }
@@ -300,11 +312,12 @@ class TunedRun {
         hi = locate(along(g), 0.0, 1.0, 1.0, tol()).hi;
       } else if (!riding(mode_)) {
         // A graze: the Hermite interpolant of g rises above zero inside the step.
-        const double d0 = rate(g, k_[0], h_), d1 = rate(g, k_[12], h_);
+        const double d0 = rate(g, k_[0], h_), d1 = rate(g, k_[12], h_), level = -1e-3 * ode_.start_depth();
+        if (std::max(g0, g1) + hermite_bulge(g0, d0, g1, d1, 1.0) <= level) continue;
         double th[2];
         const int n = hermite_stationary(g0, d0, g1, d1, 1.0, th);
         for (int j = 0; j < n; ++j) {
-          if (!(hermite_value(g0, d0, g1, d1, 1.0, th[j]) > -1e-3 * ode_.start_depth())) continue;
+          if (!(hermite_value(g0, d0, g1, d1, 1.0, th[j]) > level)) continue;
           const Poly p = along(g);
           if (!(p.at(th[j]) > 0.0)) continue;
           hi = locate(p, 0.0, th[j], 1.0, tol()).hi;
@@ -335,6 +348,8 @@ class TunedRun {
       on_root(locate(along(g), 0.0, te, g1 > g0 ? 1.0 : -1.0, tol()));
       return;
     }
+    const double bulge = hermite_bulge(g0, d0, g1, d1, te);
+    if (g0 < 0.0 ? std::max(g0, g1) + bulge < 0.0 : std::min(g0, g1) - bulge >= 0.0) return;
     double th[2];
     const int n = hermite_stationary(g0, d0, g1, d1, te, th);
     for (int i = 0; i < n; ++i) {

@@ -46,29 +46,29 @@ class TunedOde {
     if (!tridiagonal_) return ode_.rhs(a, y, dy, mode);
     const int n = F > 0 ? F : n_, p = F > 0 ? F + D : p_, f = ode_.spec().floor;
     const double* v = y + p;
-    // Frame: dy holds the force on each floor until divided by its mass.
+    // Floors with a zero beyond each end: the three diagonals in one pass.
+    std::array<double, kFloors + 2> xs, vs;
+    std::array<double, kFloors> force;
+    xs[0] = vs[0] = xs[n + 1] = vs[n + 1] = 0.0;
+    for (int i = 0; i < n; ++i) xs[i + 1] = y[i], vs[i + 1] = v[i];
     double strain = 0.0;
     for (int i = 0; i < n; ++i) {
-      double kx = 0.0, cv = 0.0;  // in SceneOde's order
-      if (i > 0) kx = kl_[i] * y[i - 1], cv = cl_[i] * v[i - 1];
-      kx += kd_[i] * y[i], cv += cd_[i] * v[i];
-      if (i + 1 < n) kx += ku_[i] * y[i + 1], cv += cu_[i] * v[i + 1];
+      const double kx = kl_[i] * xs[i] + kd_[i] * xs[i + 1] + ku_[i] * xs[i + 2];
+      force[i] = -(kx + (cl_[i] * vs[i] + cd_[i] * vs[i + 1] + cu_[i] * vs[i + 2]));
       strain += y[i] * kx;
-      dy[i] = v[i];
-      dy[p + i] = -(kx + cv);
     }
     if (tmd_m_ > 0.0) {
       const double fd = tmd_k_ * (y[n] - y[f]) + tmd_c_ * (v[n] - v[f]);
-      dy[p + f] += fd;
+      force[f] += fd;
       dy[n] = v[n];
       dy[p + n] = -fd / tmd_m_ - a;
     } else if (particle_m_ > 0.0) {
       const double fp = mode == Mode::kFree ? 0.0 : ode_.particle_force(y, mode);
-      dy[p + f] -= fp;
+      force[f] -= fp;
       dy[n] = v[n];
       dy[p + n] = fp / particle_m_ - a;
     }
-    for (int i = 0; i < n; ++i) dy[p + i] = dy[p + i] * inv_m_[i] - a;
+    for (int i = 0; i < n; ++i) dy[i] = v[i], dy[p + i] = force[i] * inv_m_[i] - a;
     dy[2 * p] = 0.5 * strain;
   }
 
