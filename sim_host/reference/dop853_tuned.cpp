@@ -115,12 +115,14 @@ template <int F, int D>
 class TunedRun {
  public:
   static constexpr int N = TunedOde<F, D>::kSize;
-  static constexpr int kCap = N > 0 ? N : kMaxSize;
+  // Vectors padded to whole AVX2 packs (the padding stays 0).
+  static constexpr int kCap = N > 0 ? (N + 3) / 4 * 4 : kMaxSize;
   using Vec = std::array<double, kCap>;
 
   TunedRun(const OdeSpec& spec, const Ground& g, double rtol)
       : rhs_(spec), ode_(rhs_.scene()), g_(g), n_(ode_.size()), rtol_(rtol) {
     const std::vector<double> sc = ode_.scales();
+    atol_.fill(1.0);
     for (int q = 0; q < size(); ++q) atol_[q] = rtol * sc[static_cast<std::size_t>(q)];
     x_top_ = linear([this](const double* y) { return ode_.top_x(y); });
     v_top_ = linear([this](const double* y) { return ode_.top_v(y); });
@@ -168,6 +170,7 @@ class TunedRun {
     double c = 0;
   };
   int size() const { return N > 0 ? N : n_; }
+  int lanes() const { return N > 0 ? kCap : n_; }  // what the vector loops run over
   static double dot(const Affine& g, const Vec& y) {
     double s = 0.0;
     for (int k = 0; k < g.n; ++k) s += g.w[k] * y[g.at[k]];
@@ -205,7 +208,7 @@ class TunedRun {
   template <int I, int... J>
   void combine(double h, Vec& out) const {
     static_assert(sizeof...(J) == nonzeros(I) && ((kA<I, J> != 0.0) && ...), "the row's non-zero coefficients");
-    for (int q = 0; q < size(); ++q) out[q] = y_[q] + h * (... + (kA<I, J> * k_[J][q]));
+    for (int q = 0; q < lanes(); ++q) out[q] = y_[q] + h * (... + (kA<I, J> * k_[J][q]));
   }
   template <int I, int... J>
   void stage(double h) {
@@ -216,7 +219,7 @@ class TunedRun {
   template <int... J>
   double error(double h, std::integer_sequence<int, J...>) const {
     double e5 = 0.0, e3 = 0.0;
-    for (int q = 0; q < size(); ++q) {
+    for (int q = 0; q < lanes(); ++q) {
       const double d5 = (... + (kE5<J> * k_[J][q])), d3 = (... + (kE3<J> * k_[J][q]));
       const double w = 1.0 / (atol_[q] + rtol_ * std::max(std::fabs(y_[q]), std::fabs(y1_[q])));
       e5 += (d5 * w) * (d5 * w);
@@ -254,7 +257,7 @@ class TunedRun {
     stage<13, 0, 6, 7, 8, 9, 10, 11, 12>(h_);
     stage<14, 0, 5, 6, 7, 10, 11, 12, 13>(h_);
     stage<15, 0, 5, 6, 7, 8, 12, 13, 14>(h_);
-    for (int q = 0; q < size(); ++q) {
+    for (int q = 0; q < lanes(); ++q) {
       const double dy = y1_[q] - y_[q];
       r_[0][q] = y_[q];
       r_[1][q] = dy;
@@ -272,13 +275,6 @@ class TunedRun {
     for (int i = 0; i < 8; ++i) p.c[i] = dot(g, r_[i]);
     p.c[0] += g.c;
     return p;
-  }
-  void state_at(double th, Vec& out) {
-    dense();
-    const double u = 1.0 - th;
-    for (int q = 0; q < size(); ++q)
-      out[q] = r_[0][q] + th * (r_[1][q] + u * (r_[2][q] + th * (r_[3][q] + u * (r_[4][q] + th * (r_[5][q] +
-               u * (r_[6][q] + th * r_[7][q]))))));
   }
   // Root tolerance in theta: a few ulps of the time.
   double tol() const { return 16.0 * std::numeric_limits<double>::epsilon() * (t0_ + s0_ + h_) / h_; }

@@ -46,29 +46,32 @@ class TunedOde {
     if (!tridiagonal_) return ode_.rhs(a, y, dy, mode);
     const int n = F > 0 ? F : n_, p = F > 0 ? F + D : p_, f = ode_.spec().floor;
     const double* v = y + p;
-    // Floors with a zero beyond each end: the three diagonals in one pass.
-    std::array<double, kFloors + 2> xs, vs;
-    std::array<double, kFloors> force;
-    xs[0] = vs[0] = xs[n + 1] = vs[n + 1] = 0.0;
-    for (int i = 0; i < n; ++i) xs[i + 1] = y[i], vs[i + 1] = v[i];
-    double strain = 0.0;
+    // Frame, row by row in SceneOde's order (scalar: the stage was just
+    // stored, and vector loads across it would wait for the stores).
+    double strain = 0.0, frame_f = 0.0;
     for (int i = 0; i < n; ++i) {
-      const double kx = kl_[i] * xs[i] + kd_[i] * xs[i + 1] + ku_[i] * xs[i + 2];
-      force[i] = -(kx + (cl_[i] * vs[i] + cd_[i] * vs[i + 1] + cu_[i] * vs[i + 2]));
+      double kx = 0.0, cv = 0.0;
+      if (i > 0) kx = kl_[i] * y[i - 1], cv = cl_[i] * v[i - 1];
+      kx += kd_[i] * y[i], cv += cd_[i] * v[i];
+      if (i + 1 < n) kx += ku_[i] * y[i + 1], cv += cu_[i] * v[i + 1];
       strain += y[i] * kx;
+      const double force = -(kx + cv);
+      if (i == f) frame_f = force;
+      dy[i] = v[i];
+      dy[p + i] = force * inv_m_[i] - a;
     }
+    // The device and its force on its floor.
     if (tmd_m_ > 0.0) {
       const double fd = tmd_k_ * (y[n] - y[f]) + tmd_c_ * (v[n] - v[f]);
-      force[f] += fd;
+      dy[p + f] = (frame_f + fd) * inv_m_[f] - a;
       dy[n] = v[n];
       dy[p + n] = -fd / tmd_m_ - a;
     } else if (particle_m_ > 0.0) {
       const double fp = mode == Mode::kFree ? 0.0 : ode_.particle_force(y, mode);
-      force[f] -= fp;
+      dy[p + f] = (frame_f - fp) * inv_m_[f] - a;
       dy[n] = v[n];
       dy[p + n] = fp / particle_m_ - a;
     }
-    for (int i = 0; i < n; ++i) dy[i] = v[i], dy[p + i] = force[i] * inv_m_[i] - a;
     dy[2 * p] = 0.5 * strain;
   }
 
