@@ -162,10 +162,10 @@ class TunedRun {
 
  private:
   // An affine function of the state (an event function, a monitor):
-  // c + sum_k w_k y[at_k] over its n non-zero weights.
+  // c + sum_k w_k y[index_k] over its n non-zero weights.
   struct Affine {
     int n = 0;
-    std::array<int, kCap> at{};
+    std::array<int, kCap> index{};
     std::array<double, kCap> w{};
     double c = 0;
   };
@@ -173,7 +173,7 @@ class TunedRun {
   int lanes() const { return N > 0 ? kCap : n_; }  // what the vector loops run over
   static double dot(const Affine& g, const Vec& y) {
     double s = 0.0;
-    for (int k = 0; k < g.n; ++k) s += g.w[k] * y[g.at[k]];
+    for (int k = 0; k < g.n; ++k) s += g.w[k] * y[g.index[k]];
     return s;
   }
   static double at(const Affine& g, const Vec& y) { return dot(g, y) + g.c; }
@@ -186,7 +186,7 @@ class TunedRun {
     Vec e{};
     for (int q = 0; q < size(); ++q) {
       e[q] = 1.0;
-      if (const double w = f(e.data()); w != 0.0) g.at[g.n] = q, g.w[g.n++] = w;
+      if (const double w = f(e.data()); w != 0.0) g.index[g.n] = q, g.w[g.n++] = w;
       e[q] = 0.0;
     }
     return g;
