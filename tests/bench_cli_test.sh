@@ -2,8 +2,9 @@
 # `vines bench SCENE --json`: one JSON object for the scene's own settings,
 # measured against data/reference: the El Centro Kuwabara scene must be within
 # 1e-6 of the reference peak with the reference's 18 contacts; the dop853
-# baseline alone; a bad option, an unknown baseline and a missing scene are
-# refused with a message; an ensemble; CVODE baselines (below).
+# baseline alone, and the reference driver in double (dop853-driver); a bad
+# option, an unknown baseline and a missing scene are refused with a message;
+# an ensemble; CVODE baselines (below).
 set -euo pipefail
 vines="$1"
 src="$2"
@@ -32,6 +33,18 @@ assert d["scalar"] == "double" and d["sensor_rate_hz"] == 50 and d["contact_rtol
 assert d["peak_rel_error"] is not None and d["peak_rel_error"] < 1e-7, d["peak_rel_error"]
 assert d["contacts"] == 18, d["contacts"]
 print("bench_cli: dop853 1e-10 peak error %.2e, %.2f ms" % (d["peak_rel_error"], 1e3 * d["wall_s_median"]))
+'
+# --baseline-methods dop853-driver: the reference's driver in double, as near at 1e-10.
+out=$("$vines" bench "$src/data/scenes/elcentro_vines.toml" --json --min-time 0.01 --baselines 1e-10 \
+  --baseline-methods dop853-driver)
+printf '%s\n' "$out" | /usr/bin/python3 -c '
+import json, sys
+ls = json.load(sys.stdin)["lines"]
+assert [l["method"] for l in ls] == ["firmware", "dop853-driver"], [l["method"] for l in ls]
+d = ls[1]
+assert d["peak_rel_error"] is not None and d["peak_rel_error"] < 1e-7, d["peak_rel_error"]
+assert d["contacts"] == 18, d["contacts"]
+print("bench_cli: dop853-driver 1e-10 peak error %.2e, %.2f ms" % (d["peak_rel_error"], 1e3 * d["wall_s_median"]))
 '
 if "$vines" bench "$src/data/scenes/elcentro_vines.toml" --baseline-methods rk4 2>/tmp/bench_cli_err.txt; then
   echo "bench_cli: --baseline-methods rk4 was accepted" >&2; exit 1

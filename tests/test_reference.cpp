@@ -1,16 +1,22 @@
 // The reference integrators (sim_host/reference): against closed forms, the
 // Hertz impact, their own convergence, the firmware loop, the stored
-// data/reference files, the CVODE baseline (or, built without it, its
-// refusal), and bad input. test_reference_slow.cpp runs the whole El Centro
-// records.
+// data/reference files, the tuned DOP853 baseline (its right-hand side, its
+// agreement with the stored references on the record's own points, its
+// convergence), the CVODE baseline (or, built without it, its refusal), and
+// bad input. test_reference_slow.cpp runs the whole El Centro records at 1 kHz.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "sim_host/reference/ode.hpp"
 #include "sim_host/reference/report.hpp"
+#include "sim_host/reference/spec.hpp"
 #include "sim_host/reference/truth.hpp"
+#include "sim_host/reference/tuned_ode.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/frame.hpp"
 #include "sim_host/scene/scene.hpp"
@@ -189,6 +195,129 @@ TEST(ReferenceAnalytic, HertzBounceMatchesContactDurationAndConservesEnergy) {
   EXPECT_LT(rel(v_out, v), 1e-11);
 }
 
+// ---- the tuned DOP853 (the `dop853` baseline of `vines bench`) ----
+
+// Its right-hand side (TunedOde: the frame's three diagonals, fixed sizes)
+// equals SceneOde<double>::rhs on random states, in every mode the scene has.
+template <int F, int D>
+void expect_same_rhs(const SceneParams& p, const char* what) {
+  const OdeSpec spec = make_spec(p);
+  const TunedOde<F, D> tuned(spec);
+  const SceneOde<double> ode(spec);
+  const int n = ode.size(), nf = ode.floors(), f = spec.floor;
+  std::vector<Mode> modes = {Mode::kFree};
+  if (ode.has_particle())
+    modes = {Mode::kFree, Mode::kContactLeft, Mode::kContactRight, Mode::kStuckLeft, Mode::kStuckRight};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> y(static_cast<std::size_t>(n)), a(y), b(y);
+  for (Mode mode : modes)
+    for (int trial = 0; trial < 200; ++trial) {
+      for (int i = 0; i < n; ++i) y[static_cast<std::size_t>(i)] = (i < n / 2 ? 0.3 : 1.0) * u(rng);
+      // The particle across the whole box and a little into either wall.
+      if (n / 2 > nf) y[static_cast<std::size_t>(nf)] = y[static_cast<std::size_t>(f)] + spec.wall_left +
+                                                          (0.5 + 0.52 * u(rng)) * (spec.wall_right - spec.wall_left);
+      const double ag = 3.0 * u(rng);
+      tuned.rhs(ag, y.data(), a.data(), mode);
+      ode.rhs(ag, y.data(), b.data(), mode);
+      double scale = 0.0;
+      for (double v : b) scale = std::max(scale, std::fabs(v));
+      for (int i = 0; i < n; ++i)
+        ASSERT_NEAR(a[static_cast<std::size_t>(i)], b[static_cast<std::size_t>(i)], 1e-13 * scale)
+            << what << ", mode " << static_cast<int>(mode) << ", component " << i;
+    }
+}
+
+TEST(ReferenceDop853, TunedRightHandSideEqualsSceneOde) {
+  for (ContactLaw law : {ContactLaw::kKuwabara, ContactLaw::kHertz, ContactLaw::kTsuji, ContactLaw::kRestitution})
+    expect_same_rhs<10, 1>(test::paper_scene(DeviceKind::kVines, law), law_name(law));
+  expect_same_rhs<10, 1>(test::paper_scene(DeviceKind::kTmd), "tmd");
+  expect_same_rhs<10, 0>(test::paper_scene(DeviceKind::kNone), "bare");
+  // Any other size at run time; a damping rule whose C is not tridiagonal
+  // (SceneOde's own banded product then).
+  SceneParams p = test::paper_scene(DeviceKind::kVines);
+  p.frame.stories = 3;
+  expect_same_rhs<0, 0>(p, "3 stories");
+  p = test::paper_scene(DeviceKind::kVines);
+  p.frame.damping = DampingRule::kModal;
+  expect_same_rhs<10, 1>(p, "modal damping");
+}
+
+// A shipped El Centro scene on the record's own points, as `vines bench`
+// feeds its baselines.
+Result on_record(const std::string& name, Method m, double rtol) {
+  host::Scene scene = host::load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/" + name + ".toml");
+  scene.params.loop.sensor_rate_hz = 1.0 / host::load_excitation(scene, "").record.dt_s;
+  const host::Excitation ex = host::load_excitation(scene, "");
+  Options o;
+  o.rtol = rtol;
+  return integrate(scene.params, ex.samples, ex.rate_hz, m, o);
+}
+
+// At rtol 1e-12 it is the long-double reference (data/reference, rtol
+// 1e-15): the peak and its time (at a zero of the top-floor velocity on the
+// dense output), E_e, the contacts and when they start (over the first 10 s:
+// later the chaos amplifies any difference, the reference driver's too), the
+// deepest overlap (at a zero of the overlap rate). Measured: peaks 2.3e-12
+// (Kuwabara), 4.9e-12 (Hertz), 7.2e-12 (Tsuji); E_e 6.9e-9, 3.4e-8, 1.9e-7
+// (the late contacts are chaotic); starts 2e-11 to 3.7e-10 s; deepest
+// overlaps 1e-11 to 1.1e-10; bare frame and TMD 6e-15.
+TEST(ReferenceDop853, TunedAgreesWithTheStoredReferences) {
+  struct Case {
+    const char* scene;
+    double peak_tol, energy_tol;
+  };
+  for (const Case& c : {Case{"elcentro_vines", 1e-10, 2e-6}, Case{"elcentro_vines_hertz", 1e-10, 2e-6},
+                        Case{"elcentro_vines_tsuji", 1e-10, 2e-6}, Case{"elcentro_bare", 1e-12, 1e-12},
+                        Case{"elcentro_tmd", 1e-12, 1e-12}}) {
+    const nlohmann::json ref = test::reference(c.scene);
+    const Result r = on_record(c.scene, Method::kDop853, 1e-12);
+    const double peak = ref["peak_top_displacement_m"].get<double>(), energy = ref["elastic_energy_Js"].get<double>();
+    const std::vector<double> starts = ref["contact_starts_s"].get<std::vector<double>>();
+    double early = 0;  // contact starts over the first 10 s
+    for (std::size_t i = 0; i < std::min(starts.size(), r.contact_start_s.size()) && starts[i] < 10.0; ++i)
+      early = std::max(early, std::fabs(r.contact_start_s[i] - starts[i]));
+    const double overlap = ref["max_overlap_m"].get<double>();
+    const double doverlap = overlap > 0.0 ? rel(r.max_overlap, overlap) : r.max_overlap;
+    std::printf("[ measured ] %s: peak %.1e (at %.1e s), E_e %.1e, contacts %d (%zu), starts %.1e s, deepest "
+                "overlap %.1e, %lld steps\n",
+                c.scene, rel(r.peak_top, peak), std::fabs(r.t_peak_top - ref["t_peak_top_s"].get<double>()),
+                rel(r.elastic_energy, energy), r.contacts, starts.size(), early, doverlap, r.steps);
+    EXPECT_LT(rel(r.peak_top, peak), c.peak_tol) << c.scene;
+    EXPECT_NEAR(r.t_peak_top, ref["t_peak_top_s"].get<double>(), 1e-8) << c.scene;
+    EXPECT_LT(rel(r.elastic_energy, energy), c.energy_tol) << c.scene;
+    EXPECT_EQ(r.contacts, ref["contacts"].get<int>()) << c.scene;
+    EXPECT_LT(early, 5e-9) << c.scene;
+    EXPECT_LT(doverlap, 1e-9) << c.scene;
+  }
+}
+
+// Its errors against the stored reference fall with its tolerance (by about
+// 100 from one line to the next, measured), as its steps grow; at each
+// tolerance it is as accurate as the reference driver in double.
+TEST(ReferenceDop853, TunedErrorFallsWithTheTolerance) {
+  const nlohmann::json ref = test::reference("elcentro_vines");
+  const double peak = ref["peak_top_displacement_m"].get<double>(), energy = ref["elastic_energy_Js"].get<double>();
+  double last_peak = 1, last_energy = 1;
+  long long last_steps = 0;
+  for (double rtol : {1e-6, 1e-8, 1e-10, 1e-12}) {
+    const Result r = on_record("elcentro_vines", Method::kDop853, rtol);
+    const Result d = on_record("elcentro_vines", Method::kDop853Driver, rtol);
+    std::printf("[ measured ] rtol %.0e: peak %.2e (driver %.2e), E_e %.2e (driver %.2e), %lld steps, %lld "
+                "rejected, %lld evaluations (driver %lld), %.2f ms (driver %.2f)\n",
+                rtol, rel(r.peak_top, peak), rel(d.peak_top, peak), rel(r.elastic_energy, energy),
+                rel(d.elastic_energy, energy), r.steps, r.rejected, r.rhs_evals, d.rhs_evals, 1e3 * r.wall_s,
+                1e3 * d.wall_s);
+    EXPECT_LT(rel(r.peak_top, peak), 0.1 * last_peak) << rtol;
+    EXPECT_LT(rel(r.elastic_energy, energy), 0.1 * last_energy) << rtol;
+    EXPECT_GT(r.steps, last_steps) << rtol;
+    EXPECT_LT(rel(r.peak_top, peak), 5 * rel(d.peak_top, peak) + 1e-13) << rtol;
+    EXPECT_LT(r.rhs_evals, d.rhs_evals) << rtol;
+    EXPECT_EQ(r.contacts, ref["contacts"].get<int>()) << rtol;
+    last_peak = rel(r.peak_top, peak), last_energy = rel(r.elastic_energy, energy), last_steps = r.steps;
+  }
+}
+
 // ---- bad input ----
 
 TEST(ReferenceInput, BadInputIsAClearException) {
@@ -240,6 +369,7 @@ TEST(Reference, WithoutCvodeSaysHowToGetIt) {
   }
   EXPECT_GT(integrate(p, a, 50, Method::kReference, {}).steps, 0);
   EXPECT_GT(integrate(p, a, 50, Method::kDop853, {}).steps, 0);
+  EXPECT_GT(integrate(p, a, 50, Method::kDop853Driver, {}).steps, 0);
 }
 #endif
 

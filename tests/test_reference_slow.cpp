@@ -132,8 +132,8 @@ TEST(ReferenceSlow, StoredFilesEqualAFreshRun) {
   }
 }
 
-// The `dop853` baseline of `vines bench` (the reference's driver in double,
-// on the record's own 50 Hz points) against data/reference/elcentro_vines.json
+// The `dop853` baseline of `vines bench` (the tuned DOP853 in double, on the
+// record's own 50 Hz points) against data/reference/elcentro_vines.json
 // (the long-double run at 1e-15): its peak and E_e errors fall with its
 // tolerance, and at 1e-12 it is the reference (peak to 1e-9, same contacts).
 TEST(ReferenceSlow, Dop853BaselineConvergesToTheStoredReference) {

@@ -134,13 +134,15 @@ BenchLine baseline_line(const Scene& base, const std::string& method, double rto
 
 }  // namespace
 
-const char* const kBaselineMethods[3] = {"dop853", "cvode-adams", "cvode-bdf"};
+const char* const kBaselineMethods[4] = {"dop853", "dop853-driver", "cvode-adams", "cvode-bdf"};
 
 reference::Method baseline_method(const std::string& name) {
   if (name == "dop853") return reference::Method::kDop853;
+  if (name == "dop853-driver") return reference::Method::kDop853Driver;
   if (name == "cvode-adams") return reference::Method::kCvodeAdams;
   if (name == "cvode-bdf") return reference::Method::kCvodeBdf;
-  throw std::runtime_error("--baseline-methods: unknown method '" + name + "' (dop853, cvode-adams, cvode-bdf)");
+  throw std::runtime_error("--baseline-methods: unknown method '" + name +
+                           "' (dop853, dop853-driver, cvode-adams, cvode-bdf)");
 }
 
 const char* scheme_name(ContactScheme s) {
@@ -150,7 +152,6 @@ const char* scheme_name(ContactScheme s) {
     default: return "adaptive";
   }
 }
-
 
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);

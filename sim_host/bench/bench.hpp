@@ -73,7 +73,7 @@ struct BenchOptions {
 };
 
 // The baseline methods by name, in table order.
-extern const char* const kBaselineMethods[3];
+extern const char* const kBaselineMethods[4];
 
 // One firmware setting of the table: scalar, sensor rate, contact tolerance,
 // contact scheme and its budget (bounded: sub-steps a step, split:

@@ -56,7 +56,7 @@ int bench(BenchArgs a) {
                      });
   if (!opt.baseline_rtols.empty() && cvode && *reference::cvode_missing())
     throw std::runtime_error(std::string("the CVODE baselines (") +
-                             (methods.empty() ? "--baseline-methods default: all three" : "--baseline-methods") +
+                             (methods.empty() ? "--baseline-methods default: all four" : "--baseline-methods") +
                              "): " + reference::cvode_missing() +
                              "; or leave them out with --baseline-methods dop853 or --no-baselines");
   std::vector<Scene> scenes;
@@ -133,11 +133,12 @@ void add_bench(CLI::App& vines) {
                                  "baseline lines (see --baseline-methods) at these tolerances, fed the record's own "
                                  "points (default 1e-6,1e-8,1e-10; none with --json)");
   cmd->add_option("--baseline-methods", opt.baseline_methods,
-                  "baselines: dop853 (DOP853 with event location, double), cvode-adams, cvode-bdf (SUNDIALS "
-                  "CVODE) (default: all three)")
+                  "baselines: dop853 (DOP853 in double, events on its dense output), dop853-driver (the "
+                  "reference's driver in double, events by re-taking the step), cvode-adams, cvode-bdf (SUNDIALS "
+                  "CVODE) (default: all four)")
       ->type_name("LIST")
       ->delimiter(',')
-      ->check(CLI::IsMember({"dop853", "cvode-adams", "cvode-bdf"}));
+      ->check(CLI::IsMember({"dop853", "dop853-driver", "cvode-adams", "cvode-bdf"}));
   cmd->add_flag("--no-baselines", a->no_baselines, "no baseline lines");
   cmd->add_option("--ensemble", a->ensemble,
                   "also run every line over N members (VI NES scenes: the AT2 records beside the scene's record at "

@@ -1,6 +1,6 @@
 // Internals shared by the reference and CVODE integrators: the ground input,
 // the bookkeeping of peaks and contacts, what an event does (the firmware's
-// contact-mode state machine), the two drivers.
+// contact-mode state machine), the integrators.
 #pragma once
 
 #include <cmath>
@@ -46,7 +46,7 @@ struct Tally {
   }
 };
 
-// What the contact-mode transitions (contact_mode.hpp) do in both drivers
+// What the contact-mode transitions (contact_mode.hpp) do in the drivers
 // at an event at time t on the state y: Newton's impact law applied and
 // tallied, a contact's start and end tallied.
 template <typename T>
@@ -81,9 +81,11 @@ bool take_event(Mode& mode, int side, const SceneOde<T>& ode, T* y, Tally& tally
 }
 
 // DOP853 with event location in scalar T (long double: the reference;
-// double: the bench baseline); instantiated for those two.
+// double: the `dop853-driver` baseline); instantiated for those two.
 template <typename T>
 Result integrate_dop853(const OdeSpec& spec, const Ground& g, double rtol);
+// The tuned DOP853 in double (dop853_tuned.cpp): events on the dense output.
+Result integrate_dop853_tuned(const OdeSpec& spec, const Ground& g, double rtol);
 Result integrate_cvode(const OdeSpec& spec, const Ground& g, double rtol, bool bdf);
 
 // Stationary points in (0, 1) of the cubic Hermite interpolant on a step of

@@ -46,6 +46,7 @@ const char* method_name(Method m) {
   switch (m) {
     case Method::kReference: return "reference (DOP853, long double)";
     case Method::kDop853: return "DOP853 (double)";
+    case Method::kDop853Driver: return "DOP853 reference driver (double)";
     case Method::kCvodeAdams: return "CVODE Adams (fixed point)";
     default: return "CVODE BDF (Newton, dense)";
   }
@@ -74,11 +75,14 @@ Result integrate(const SceneParams& p, const std::vector<double>& samples, doubl
   if (cvode && *cvode_missing()) throw std::runtime_error(std::string(method_name(m)) + ": " + cvode_missing());
   const auto t0 = std::chrono::steady_clock::now();
 #ifdef VINES_HAVE_CVODE
-  Result r = ref                    ? integrate_dop853<long double>(spec, g, rtol)
-             : m == Method::kDop853 ? integrate_dop853<double>(spec, g, rtol)
-                                    : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
+  Result r = ref                          ? integrate_dop853<long double>(spec, g, rtol)
+             : m == Method::kDop853       ? integrate_dop853_tuned(spec, g, rtol)
+             : m == Method::kDop853Driver ? integrate_dop853<double>(spec, g, rtol)
+                                          : integrate_cvode(spec, g, rtol, m == Method::kCvodeBdf);
 #else
-  Result r = ref ? integrate_dop853<long double>(spec, g, rtol) : integrate_dop853<double>(spec, g, rtol);
+  Result r = ref                    ? integrate_dop853<long double>(spec, g, rtol)
+             : m == Method::kDop853 ? integrate_dop853_tuned(spec, g, rtol)
+                                    : integrate_dop853<double>(spec, g, rtol);
 #endif
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

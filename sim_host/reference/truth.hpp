@@ -3,12 +3,17 @@
 //    (a_g has a kink there), events located to long-double rounding by
 //    re-stepping (Illinois), the peak of |x_top| at the located zeros of the
 //    top-floor velocity;
-//  - kDop853: the same driver in double (the `dop853` baseline of `vines
-//    bench`: DOP853 with event location at a working tolerance);
+//  - kDop853: the `dop853` baseline of `vines bench`, DOP853 in double as a
+//    competitor would write it: a fixed-size state on the stack, FSAL, the
+//    step size carried across samples, events and the peak found on the
+//    7th-order dense output, the step re-taken once to each event
+//    (dop853_tuned.cpp);
+//  - kDop853Driver: the reference's own driver in double (the `dop853-driver`
+//    baseline: events located by re-taking the step);
 //  - kCvodeAdams, kCvodeBdf: SUNDIALS CVODE on the same ODE in double, Adams
-//    with fixed-point iteration or BDF with Newton and a dense solver, roots
-//    for the events, re-initialised at every mode switch, stopping at every
-//    sample.
+//    with fixed-point iteration (order at most 5) or BDF with Newton and a
+//    dense solver, roots for the events, re-initialised at every mode
+//    switch, stopping at every sample.
 // Same model as the firmware (the device is designed by the firmware's design
 // functions), integrated in physical coordinates by other code.
 #pragma once
@@ -20,7 +25,7 @@
 
 namespace vines::host::reference {
 
-enum class Method { kReference, kDop853, kCvodeAdams, kCvodeBdf };
+enum class Method { kReference, kDop853, kDop853Driver, kCvodeAdams, kCvodeBdf };
 
 struct Options {
   double rtol = 0;        // 0: method default (reference 1e-15, DOP853 and CVODE 1e-8)
