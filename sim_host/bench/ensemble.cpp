@@ -66,23 +66,29 @@ EnsembleStat stat_of(std::vector<double> v) {
 struct Outcome {
   double peak = 0, elastic_energy = 0;
   int contacts = 0;
+  bool failed = false;  // the method gave up on this member (its message on stderr)
 };
 
-// The line's statistics over the members.
+// The line's statistics over the members it ran (a failed one is counted apart).
 void score(const std::vector<MemberTruth>& truth, const std::vector<Outcome>& out, EnsembleLine* l) {
   std::vector<double> peak, x_r, E_r;
   int same = 0;
   double diff = 0;
   for (std::size_t m = 0; m < truth.size(); ++m) {
     const MemberTruth& t = truth[m];
+    if (out[m].failed) {
+      ++l->failed;
+      continue;
+    }
     peak.push_back(std::fabs(out[m].peak - t.device.peak_top) / t.device.peak_top);
     x_r.push_back(std::fabs(out[m].peak - t.device.peak_top) / t.bare.peak_top);
     E_r.push_back(std::fabs(out[m].elastic_energy - t.device.elastic_energy) / t.bare.elastic_energy);
     same += out[m].contacts == t.device.contacts;
     diff += std::abs(out[m].contacts - t.device.contacts);
   }
-  const double n = static_cast<double>(truth.size());
+  const double n = static_cast<double>(peak.size());
   l->members = static_cast<int>(truth.size());
+  if (peak.empty()) return;  // failed on every member: no figures
   l->peak = stat_of(peak);
   l->x_r = stat_of(x_r);
   l->E_r = stat_of(E_r);
@@ -92,14 +98,19 @@ void score(const std::vector<MemberTruth>& truth, const std::vector<Outcome>& ou
 
 // Runs run(m) for every member, in passes over all of them until opt's
 // minimum time (one pass at least); returns the mean wall time of a run.
+// A run that returns 0 (failed) is not counted.
 template <typename Run>
 double time_members(std::size_t members, const BenchOptions& opt, Run run) {
   double total = 0;
   std::size_t runs = 0;
   do {
-    for (std::size_t m = 0; m < members; ++m, ++runs) total += run(m);
-  } while (total < opt.min_time_s);
-  return total / static_cast<double>(runs);
+    for (std::size_t m = 0; m < members; ++m) {
+      const double wall = run(m);
+      total += wall;
+      runs += wall > 0;
+    }
+  } while (runs > 0 && total < opt.min_time_s);
+  return runs > 0 ? total / static_cast<double>(runs) : 0.0;
 }
 
 EnsembleLine firmware_line(const std::vector<EnsembleMember>& members, const std::vector<MemberTruth>& truth,
@@ -145,11 +156,24 @@ EnsembleLine baseline_line(const std::vector<EnsembleMember>& members, const std
   std::vector<Outcome> out(members.size());
   reference::Options o;
   o.rtol = set.rtol;
+  // A member the method fails on (CVODE's root finding can give up) is
+  // reported and counted, not timed: the line's figures are over the rest.
+  std::vector<bool> told(members.size(), false);
   l.run_s = time_members(members.size(), opt, [&](std::size_t m) {
     const MemberTruth& t = truth[m];
-    const reference::Result r = reference::integrate(t.params, t.ex.samples, t.ex.rate_hz, baseline_method(set.method), o);
-    out[m] = {r.peak_top, r.elastic_energy, r.contacts};
-    return r.wall_s;
+    try {
+      const reference::Result r =
+          reference::integrate(t.params, t.ex.samples, t.ex.rate_hz, baseline_method(set.method), o);
+      out[m] = {r.peak_top, r.elastic_energy, r.contacts, false};
+      return r.wall_s;
+    } catch (const std::runtime_error& e) {
+      if (!told[m])
+        std::fprintf(stderr, "vines bench: %s at rtol %g failed on member %s: %s\n", set.method.c_str(), set.rtol,
+                     members[m].label.c_str(), e.what());
+      told[m] = true;
+      out[m].failed = true;
+      return 0.0;
+    }
   });
   score(truth, out, &l);
   return l;
@@ -254,23 +278,25 @@ nlohmann::json ensemble_line_json(const EnsembleLine& l) {
   j["E_r_abs_error"] = stat(l.E_r);
   j["contacts_same_share"] = l.contacts_same;
   j["contacts_abs_diff_mean"] = l.contacts_diff;
+  j["failed_members"] = l.failed;
   return j;
 }
 
 std::string format_ensemble_table(const std::vector<EnsembleLine>& lines) {
   std::string out;
   char buf[320];
-  std::snprintf(buf, sizeof buf, "%-12s %-10s %-6s %7s %7s %8s %9s %9s %9s %9s %9s %9s %6s %6s\n", "method", "scheme",
-                "scalar", "rate_hz", "rtol", "run_ms", "peak_mean", "peak_p90", "x_r_mean", "x_r_p90", "E_r_mean",
-                "E_r_p90", "c_same", "c_diff");
+  std::snprintf(buf, sizeof buf, "%-13s %-10s %-6s %7s %7s %8s %9s %9s %9s %9s %9s %9s %6s %6s %6s\n", "method",
+                "scheme", "scalar", "rate_hz", "rtol", "run_ms", "peak_mean", "peak_p90", "x_r_mean", "x_r_p90",
+                "E_r_mean", "E_r_p90", "c_same", "c_diff", "failed");
   out += buf;
   for (const EnsembleLine& l : lines) {
     const BenchLine& b = l.setting;
     char scheme[32] = "";
     if (b.method == "firmware") std::snprintf(scheme, sizeof scheme, b.budget > 0 ? "%s/%d" : "%s", b.scheme.c_str(), b.budget);
-    std::snprintf(buf, sizeof buf, "%-12s %-10s %-6s %7.0f %7.3g %8.4f %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %5.0f%% %6.2f\n",
+    std::snprintf(buf, sizeof buf,
+                  "%-13s %-10s %-6s %7.0f %7.3g %8.4f %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %5.0f%% %6.2f %6d\n",
                   b.method.c_str(), scheme, b.scalar.c_str(), b.rate_hz, b.rtol, 1e3 * l.run_s, l.peak.mean, l.peak.p90,
-                  l.x_r.mean, l.x_r.p90, l.E_r.mean, l.E_r.p90, 100 * l.contacts_same, l.contacts_diff);
+                  l.x_r.mean, l.x_r.p90, l.E_r.mean, l.E_r.p90, 100 * l.contacts_same, l.contacts_diff, l.failed);
     out += buf;
   }
   return out;

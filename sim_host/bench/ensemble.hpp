@@ -45,6 +45,7 @@ struct EnsembleLine {
   EnsembleStat peak, x_r, E_r;  // peak: relative; x_r, E_r: absolute (fractions), against the bare reference
   double contacts_same = 0;  // share of members with the reference's contact count
   double contacts_diff = 0;  // mean |contacts - reference's|
+  int failed = 0;            // members the method gave up on (left out of the figures above)
 };
 
 // Every line bench_scene would give, over the members (references computed
