@@ -4,7 +4,7 @@
 # 1e-6 of the reference peak with the reference's 18 contacts; the dop853
 # baseline alone, and the reference driver in double (dop853-driver); a bad
 # option, an unknown baseline and a missing scene are refused with a message;
-# CVODE baselines (below).
+# an ensemble; CVODE baselines (below).
 set -euo pipefail
 vines="$1"
 src="$2"
@@ -54,6 +54,29 @@ if "$vines" bench "$src/data/scenes/elcentro_vines.toml" --rates fifty 2>/tmp/be
   echo "bench_cli: --rates fifty was accepted" >&2; exit 1
 fi
 grep -q -- "--rates" /tmp/bench_cli_err.txt
+# --ensemble 6: every line over 3 records and 3 initial conditions, each
+# against its own long-double reference. The loop's error falls with its
+# tolerance (1e-4 -> 1e-10) by orders of magnitude, and at 1e-10 it is near
+# the reference on every member, with the same contacts on most.
+out=$("$vines" bench "$src/data/scenes/elcentro_vines.toml" --rates 50 --rtols 1e-4,1e-10 --ensemble 6 \
+  --no-baselines --min-time 0.01 --json 2>/dev/null)
+printf '%s\n' "$out" | /usr/bin/python3 -c '
+import json, sys
+e = json.load(sys.stdin)["ensemble"]
+assert [l["contact_rtol"] for l in e] == [1e-4, 1e-10], e
+loose, tight = e
+assert all(l["members"] == 6 and l["run_s_mean"] > 0 for l in e), e
+assert tight["peak_rel_error"]["p90"] < 1e-8, tight
+assert tight["x_r_abs_error"]["p90"] < 1e-8 and tight["E_r_abs_error"]["p90"] < 1e-6, tight
+assert tight["contacts_same_share"] >= 0.8, tight
+assert loose["peak_rel_error"]["mean"] > 1e3 * tight["peak_rel_error"]["mean"], (loose, tight)
+print("bench_cli: ensemble of 6, p90 peak error %.1e at 1e-10, %.1e at 1e-4" %
+      (tight["peak_rel_error"]["p90"], loose["peak_rel_error"]["p90"]))
+'
+if "$vines" bench "$src/data/scenes/elcentro_tmd.toml" --ensemble 4 2>/tmp/bench_cli_err.txt >/dev/null; then
+  echo "bench_cli: --ensemble on a TMD scene was accepted" >&2; exit 1
+fi
+grep -q "elcentro_tmd.toml has no VI NES" /tmp/bench_cli_err.txt
 if "$vines" bench /nonexistent.toml --json 2>/tmp/bench_cli_err.txt; then
   echo "bench_cli: a missing scene was accepted" >&2; exit 1
 fi

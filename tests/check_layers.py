@@ -22,7 +22,7 @@ nothing reaches out of its folder with "../". Standard library only.
 Inside sim_host/, the rooms (sim_host/README.md), each including only its own
 files and the rooms below it; no source file outside a room, no room of more
 than 20 source files:
-  io < scene < engines < run < reference < studies, hil (hil/, hil/link/,
+  io < scene < engines < run < reference < studies < bench, hil (hil/, hil/link/,
   hil/modes/: one bench) < python < cli
 
 No contact law is named outside its registry (firmware/include/vines/
@@ -65,8 +65,9 @@ _HIL = ["hil", "hil/link", "hil/modes"]
 HOST_ROOMS = {"io": [], "scene": _BELOW[:1], "engines": _BELOW[:2], "run": _BELOW[:3],
               "reference": _BELOW[:4], "studies": _BELOW}
 HOST_ROOMS.update({room: _BELOW + _HIL for room in _HIL})
+HOST_ROOMS["bench"] = _BELOW + ["studies"]
 HOST_ROOMS["python"] = _BELOW + _HIL + ["studies"]
-HOST_ROOMS["cli"] = _BELOW + _HIL + ["studies", "python"]
+HOST_ROOMS["cli"] = _BELOW + _HIL + ["studies", "bench", "python"]
 ROOM_MAX_FILES = 20
 SOURCE = (".hpp", ".h", ".cpp", ".c", ".in")
 

@@ -15,7 +15,7 @@
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/frame.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/studies/bench.hpp"
+#include "sim_host/bench/bench.hpp"
 #include "reference_support.hpp"
 #include "support.hpp"
 #include "vines/frame.hpp"

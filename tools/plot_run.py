@@ -3,7 +3,7 @@
 
 Usage: plot_run.py RUN_DIR [RUN_DIR ...] [--out DIR] [--dpi DPI]
 
-Each RUN_DIR holds summary.json and timeseries.csv (a bare, TMD or VI NES run).
+Each RUN_DIR holds summary.json and timeseries.csv or timeseries.npy (a bare, TMD or VI NES run).
 Writes into --out (default: out/plots; not a run folder, which vines run owns):
   fig6_top_displacement.png  top-floor displacement vs time, bare vs each device
   fig7_particle_walls.png    VI NES particle and box walls vs time, contacts marked
@@ -43,6 +43,9 @@ class Run:
             fail(f"run directory not found: {path}")
         self.summary_path = os.path.join(path, "summary.json")
         self.csv_path = os.path.join(path, "timeseries.csv")
+        npy = os.path.join(path, "timeseries.npy")
+        if not os.path.isfile(self.csv_path) and os.path.isfile(npy):
+            self.csv_path = npy
         for p in (self.summary_path, self.csv_path):
             if not os.path.isfile(p):
                 fail(f"missing file: {p}")
@@ -69,7 +72,15 @@ class Run:
         return d[name]
 
     def col(self, name):
-        """A column of timeseries.csv as a float array (file read once, lazily)."""
+        """A column of the time series as a float array (file read once, lazily)."""
+        if self._cols is None and self.csv_path.endswith(".npy"):
+            try:
+                data = np.load(self.csv_path)
+            except (OSError, ValueError) as e:
+                fail(f"cannot read {self.csv_path}: {e}")
+            if data.dtype.names is None:
+                fail(f"{self.csv_path}: not a table of named columns")
+            self._cols = {h: data[h].astype(float) for h in data.dtype.names}
         if self._cols is None:
             try:
                 with open(self.csv_path) as fh:

@@ -9,11 +9,17 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
+start=$SECONDS
+lap() { echo "test.sh: $1 at $((SECONDS - start)) s"; }
+
 bash tools/setup.sh all
+lap "packages ready"
 
 cmake --preset release
 cmake --build --preset release -j2
+lap "release built"
 ctest --preset release
+lap "release tested"
 
 # The host under AddressSanitizer and UBSan (preset debug): the subset labelled
 # unit_sanitize (tests/README.md: which tests, why a subset, its time); any
@@ -21,10 +27,12 @@ ctest --preset release
 cmake --preset debug
 cmake --build --preset debug -j2 --target sanitize_tests
 ctest --preset sanitize
+lap "sanitizer subset tested"
 
 for target in $(grep -oE '^[a-z0-9-]+ *\|' hal/mcu/boards.txt | tr -d ' |'); do
   cmake --preset "$target"
   cmake --build --preset "$target" -j2
   ctest --preset "$target"
+  lap "$target tested"
 done
-echo "test.sh: all passed"
+echo "test.sh: all passed in $((SECONDS - start)) s"

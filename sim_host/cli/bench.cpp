@@ -11,7 +11,8 @@
 #include "sim_host/io/csv.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/studies/bench.hpp"
+#include "sim_host/bench/bench.hpp"
+#include "sim_host/bench/ensemble.hpp"
 #include "vines/params.hpp"
 
 namespace vines::cli {
@@ -21,6 +22,7 @@ struct BenchArgs {
   std::vector<std::string> scenes;
   host::BenchOptions opt;
   bool as_json = false, no_baselines = false;
+  int ensemble = 0;  // members; 0: the scene alone
   std::string csv;
   const CLI::Option* baselines = nullptr;  // --baselines, given or not
 };
@@ -57,23 +59,40 @@ int bench(BenchArgs a) {
                              (methods.empty() ? "--baseline-methods default: all four" : "--baseline-methods") +
                              "): " + reference::cvode_missing() +
                              "; or leave them out with --baseline-methods dop853 or --no-baselines");
-  std::vector<BenchLine> lines;
+  std::vector<Scene> scenes;
   for (const std::string& path : a.scenes) {
-    const Scene scene = load_scene(path);
+    scenes.push_back(load_scene(path));
+    if (a.ensemble > 0 && scenes.back().params.device.kind != DeviceKind::kVines)
+      throw std::runtime_error("--ensemble: " + path + " has no VI NES (the ensemble varies the sphere and the record)");
+  }
+  std::vector<BenchLine> lines;
+  std::vector<EnsembleLine> ensemble;
+  for (const Scene& scene : scenes) {
     BenchOptions o = opt;
     if (o.scalars.empty()) o.scalars = {scalar_name(scene.scalar)};
     const std::vector<BenchLine> ls = bench_scene(scene, o);
     lines.insert(lines.end(), ls.begin(), ls.end());
     if (!a.as_json) std::fputs(format_table(ls).c_str(), stdout);
+    if (a.ensemble == 0) continue;
+    // The same settings over the ensemble, each member against its own reference.
+    const std::vector<EnsembleLine> es = bench_ensemble(scene, o, a.ensemble);
+    ensemble.insert(ensemble.end(), es.begin(), es.end());
+    if (!a.as_json)
+      std::printf("%s over an ensemble of %d (errors: |.| against each member's reference; run_ms: one run):\n%s",
+                  scene.name.c_str(), a.ensemble, format_ensemble_table(es).c_str());
   }
   if (!a.csv.empty()) write_csv(a.csv, lines);
   if (a.as_json) {
     nlohmann::json j;
-    if (lines.size() == 1) {
+    if (lines.size() == 1 && a.ensemble == 0) {
       j = line_json(lines[0]);
     } else {
       j["lines"] = nlohmann::json::array();
       for (const BenchLine& l : lines) j["lines"].push_back(line_json(l));
+    }
+    if (a.ensemble > 0) {
+      j["ensemble"] = nlohmann::json::array();
+      for (const EnsembleLine& l : ensemble) j["ensemble"].push_back(ensemble_line_json(l));
     }
     std::printf("%s\n", j.dump(2).c_str());
   }
@@ -121,6 +140,15 @@ void add_bench(CLI::App& vines) {
       ->delimiter(',')
       ->check(CLI::IsMember({"dop853", "dop853-driver", "cvode-adams", "cvode-bdf"}));
   cmd->add_flag("--no-baselines", a->no_baselines, "no baseline lines");
+  cmd->add_option("--ensemble", a->ensemble,
+                  "also run every line over N members (VI NES scenes: the AT2 records beside the scene's record at "
+                  "its PGA, and initial conditions of the 33 x 33 grid), each against its own converged reference: "
+                  "mean and p90 of the errors, contact agreement, cost of a run")
+      ->type_name("N")
+      ->check(CLI::Range(2, 100000));
+  cmd->add_option("--threads", opt.threads, "threads for the ensemble's references (default: all cores)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 4096));
   cmd->add_option("--min-time", opt.min_time_s, "time each line for at least S seconds (default 0.3)")
       ->type_name("S")
       ->check(positive_up_to(std::numeric_limits<double>::max()));

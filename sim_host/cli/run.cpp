@@ -31,6 +31,7 @@ struct RunArgs {
   const CLI::Option* out = nullptr;  // --out, given or not
   const CLI::App* cmd = nullptr;     // the options given (check_reading)
   bool accept_degraded = false;
+  std::string format;  // --format: "" the scene's [output] format
 };
 
 // How to read the --record file: an option the file's format does not take
@@ -61,7 +62,9 @@ int run(RunArgs a) {
   opt.record_reading.format = *host::named(host::kRecordFormats, a.record_format);  // checked by CLI11
   opt.record_reading.units = *host::named(host::kRecordUnits, a.record_units);
   check_reading(a);
-  const Scene scene = load_scene(a.scene_path);
+  Scene scene = load_scene(a.scene_path);
+  if (!a.format.empty())
+    scene.output.format = a.format == "npy" ? host::TimeseriesFormat::kNpy : host::TimeseriesFormat::kCsv;
   if (a.out->count() == 0) opt.out_dir = "out/" + safe_file_name(scene.name);
   const RunReport r = run_scene(scene, opt);
   const vines::SceneParams& p = scene.params;
@@ -101,7 +104,7 @@ void add_run(CLI::App& vines) {
   CLI::App* cmd = add_command(vines, "run",
                               "Run a scene (frame, device, contact law, record). With a device, the bare frame runs "
                               "on the same record too and x_r, E_r are reported. Writes DIR/summary.json and "
-                              "DIR/timeseries.csv.",
+                              "DIR/timeseries.csv (or .npy).",
                               "", [a] { return run(*a); });
   a->cmd = cmd;
   cmd->add_option("SCENE.toml", a->scene_path, "scene file (see data/scenes/README.md)")->required();
@@ -129,6 +132,12 @@ void add_run(CLI::App& vines) {
                            "removed (default: out/<scene name>)")
                ->type_name("DIR")
                ->check(non_empty_path());
+  cmd->add_option("--format", a->format,
+                  "timeseries format: csv (text, each number in its shortest exact form) or npy (NumPy, the "
+                  "values' bytes; numpy.load reads it); both read back bit for bit (default: the scene's "
+                  "[output] format, else csv)")
+      ->type_name("FORMAT")
+      ->check(CLI::IsMember({"csv", "npy"}));
   cmd->add_flag("--quiet", a->opt.quiet, "print nothing but errors and a degraded status");
   add_accept_degraded(*cmd, &a->accept_degraded);
 }

@@ -65,6 +65,14 @@ CsvWriter& CsvWriter::number(double v, const char* format) {
   return *this;
 }
 
+CsvWriter& CsvWriter::exact(double v) {
+  char buf[32];  // the longest shortest form, "-2.2250738585072014e-308", is 24
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  separate();
+  put(buf, static_cast<std::size_t>(r.ptr - buf));
+  return *this;
+}
+
 CsvWriter& CsvWriter::integer(long long v) { return raw(std::to_string(v)); }
 
 CsvWriter& CsvWriter::empty() { return raw(""); }

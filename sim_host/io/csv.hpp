@@ -1,7 +1,8 @@
 // One CSV writer for the files the commands write (sweep results.csv, run
 // timeseries.csv, bench --csv, hil --csv): comma-separated cells, one row a line; a
 // text cell is quoted when it holds a comma, a quote or a line break (quotes
-// doubled, RFC 4180), or always with quoted(); numbers in a printf format.
+// doubled, RFC 4180), or always with quoted(); numbers in a printf format or
+// exact (shortest round trip).
 // Writes are checked and atomic (sim_host/io/output.hpp): the file appears, whole,
 // at close(); a write that fails throws a std::runtime_error naming the file
 // and the reason, and a writer dropped before close() leaves the old file as it was.
@@ -27,6 +28,7 @@ class CsvWriter {
   CsvWriter& quoted(const std::string& s);  // always quoted
   CsvWriter& raw(const std::string& s);     // as is (already CSV-safe)
   CsvWriter& number(double v, const char* format);  // e.g. "%.10g"
+  CsvWriter& exact(double v);  // shortest text that reads back to v bit for bit
   CsvWriter& integer(long long v);
   CsvWriter& empty();                       // an empty cell
   void end_row();

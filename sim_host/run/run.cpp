@@ -11,6 +11,7 @@
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/io/csv.hpp"
+#include "sim_host/io/npy.hpp"
 #include "sim_host/io/digest.hpp"
 #include "sim_host/io/output.hpp"
 #include "sim_host/run/drive.hpp"
@@ -24,21 +25,56 @@ using nlohmann::json;
 
 std::vector<double> head(const FloorArray& a, int n) { return {a.begin(), a.begin() + n}; }
 
-// One engine run over the samples; snapshots every `every` steps.
+// What a run keeps every `every` steps: its snapshots (RunReport::series),
+// and the timeseries' values (a device run: its columns; the bare frame's
+// beside it: its top floor and E_e), each row `width` doubles.
+struct Keep {
+  bool snapshots = false;
+  int width = 0;  // 0: no values
+  bool bare = false;
+};
+
 struct Trace {
   RunTotals totals;
   ModelInfo info;
   std::vector<Snapshot> rows;
+  std::vector<double> values;  // rows of Keep::width
   double wall_s = 0;
 };
 
-Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every) {
+// A snapshot's values in the timeseries' columns (the device's), or the
+// bare frame's two.
+void append_values(const Snapshot& s, int n, DeviceKind kind, bool bare, std::vector<double>* v) {
+  if (bare) {
+    v->insert(v->end(), {s.x[n - 1], s.elastic_energy});
+    return;
+  }
+  v->insert(v->end(), {s.t, s.ag});
+  for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift}) v->insert(v->end(), a->begin(), a->begin() + n);
+  v->push_back(s.elastic_energy);
+  if (kind == DeviceKind::kVines)
+    v->insert(v->end(), {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force,
+                         static_cast<double>(s.mode)});
+  if (kind == DeviceKind::kTmd) v->insert(v->end(), {s.tmd_x, s.tmd_v});
+}
+
+// One engine run over the samples, keeping what `keep` asks every `every` steps.
+Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every, const Keep& keep) {
   std::unique_ptr<Engine> eng = build_engine(p, scene.scalar, scene.path);
   Trace tr;
   tr.info = eng->info();
+  // Every row's room at once: no copies as they grow.
+  const std::size_t rows = every > 0 ? ex.samples.size() / static_cast<std::size_t>(every) + 2 : 0;
+  if (keep.snapshots) tr.rows.reserve(rows);
+  tr.values.reserve(rows * static_cast<std::size_t>(keep.width));
+  const int n = tr.info.stories;
   const auto t0 = std::chrono::steady_clock::now();
   hal::RecordSource src(ex.samples, ex.rate_hz);
-  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) { tr.rows.push_back(eng->snapshot()); });
+  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) {
+    const Snapshot s = eng->snapshot();
+    if (keep.width > 0) append_values(s, n, p.device.kind, keep.bare, &tr.values);
+    if (keep.snapshots) tr.rows.push_back(s);
+  });
   tr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   tr.totals = eng->totals();
   return tr;
@@ -90,36 +126,52 @@ json device_json(DeviceKind kind, const ModelInfo& info) {
   return dp;
 }
 
-void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
-  CsvWriter csv(file.string());
-  const int n = dev.info.stories;
-  const DeviceKind kind = scene.params.device.kind;
-  // Header: time, ground, per-floor quantities, E_e, the device's state, the bare frame's.
-  csv.raw("t_s").raw("ag_mps2");
+// The timeseries' columns: time, ground, per-floor quantities, E_e, the
+// device's state, the bare frame's; contact_mode is an integer.
+std::vector<NpyField> timeseries_columns(const Scene& scene, int n, bool bare) {
+  std::vector<NpyField> c{{"t_s"}, {"ag_mps2"}};
   for (const char* q : {"x", "v", "acc", "drift"})
     for (int i = 1; i <= n; ++i)
-      csv.raw(q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2"));
-  csv.raw("Ee_Js");
-  if (kind == DeviceKind::kVines)
-    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n", "contact_mode"})
-      csv.raw(h);
-  if (kind == DeviceKind::kTmd) csv.raw("tmd_x_m").raw("tmd_v_mps");
-  if (bare) csv.raw("bare_x_top_m").raw("bare_Ee_Js");
-  csv.end_row();
-  // One row per snapshot: time to the microsecond, the rest to 9 digits.
-  constexpr const char* kValue = "%.9g";
-  for (std::size_t r = 0; r < dev.rows.size(); ++r) {
-    const Snapshot& s = dev.rows[r];
-    csv.number(s.t, "%.6f").number(s.ag, kValue);
-    for (const FloorArray* a : {&s.x, &s.v, &s.acc, &s.drift})
-      for (int i = 0; i < n; ++i) csv.number((*a)[i], kValue);
-    csv.number(s.elastic_energy, kValue);
-    if (kind == DeviceKind::kVines) {
-      for (double v : {s.particle_x, s.particle_v, s.wall_left, s.wall_right, s.contact_force}) csv.number(v, kValue);
-      csv.integer(s.mode);
+      c.push_back({q + std::to_string(i) + (q[0] == 'x' || q[0] == 'd' ? "_m" : q[0] == 'v' ? "_mps" : "_mps2")});
+  c.push_back({"Ee_Js"});
+  const DeviceKind kind = scene.params.device.kind;
+  if (kind == DeviceKind::kVines) {
+    for (const char* h : {"particle_x_m", "particle_v_mps", "wall_left_m", "wall_right_m", "contact_force_n"})
+      c.push_back({h});
+    c.push_back({"contact_mode", true});
+  }
+  if (kind == DeviceKind::kTmd) c.insert(c.end(), {{"tmd_x_m"}, {"tmd_v_mps"}});
+  if (bare) c.insert(c.end(), {{"bare_x_top_m"}, {"bare_Ee_Js"}});
+  return c;
+}
+
+// timeseries.csv (every number in its shortest exact form) or
+// timeseries.npy: the same columns, values bit for bit either way. A row is
+// the device run's values, then the bare frame's.
+void write_timeseries(const fs::path& file, const Scene& scene, const Trace& dev, const Trace* bare) {
+  const std::vector<NpyField> cols = timeseries_columns(scene, dev.info.stories, bare != nullptr);
+  const std::size_t width = cols.size() - (bare ? 2 : 0), rows = dev.values.size() / width;
+  std::vector<double> v(cols.size());
+  auto row = [&](std::size_t r) {
+    std::copy_n(dev.values.begin() + static_cast<std::ptrdiff_t>(r * width), width, v.begin());
+    if (bare) std::copy_n(bare->values.begin() + static_cast<std::ptrdiff_t>(2 * r), 2, v.begin() + width);
+  };
+  if (scene.output.format == TimeseriesFormat::kNpy) {
+    NpyWriter npy(file.string(), cols, rows);
+    for (std::size_t r = 0; r < rows; ++r) {
+      row(r);
+      npy.row(v.data());
     }
-    if (kind == DeviceKind::kTmd) csv.number(s.tmd_x, kValue).number(s.tmd_v, kValue);
-    if (bare) csv.number(bare->rows[r].x[n - 1], kValue).number(bare->rows[r].elastic_energy, kValue);
+    npy.close();
+    return;
+  }
+  CsvWriter csv(file.string());
+  for (const NpyField& c : cols) csv.raw(c.name);
+  csv.end_row();
+  for (std::size_t r = 0; r < rows; ++r) {
+    row(r);
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      cols[i].integer ? csv.integer(std::llround(v[i])) : csv.exact(v[i]);
     csv.end_row();
   }
   csv.close();
@@ -201,16 +253,18 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
     d.add(scene.path);
     d.add_file(scene.path);
     d.add_file(ex.record.path);
-    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv"}, d.hex());
+    out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv", "timeseries.npy"},
+                d.hex());
   }
 
   // The device run, and with a device the bare frame on the same samples.
-  const Trace dev = run_engine(scene, p, ex, every);
+  const int width = series ? static_cast<int>(timeseries_columns(scene, p.frame.stories, false).size()) : 0;
+  const Trace dev = run_engine(scene, p, ex, every, Keep{opt.keep_series, width, false});
   Trace bare;
   if (has_device) {
     SceneParams pb = p;
     pb.device.kind = DeviceKind::kNone;
-    bare = run_engine(scene, pb, ex, every);
+    bare = run_engine(scene, pb, ex, every, Keep{opt.keep_series, series ? 2 : 0, true});
   }
   RunReport r;
   r.scene = scene.name;
@@ -225,13 +279,14 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
   r.wall_s = dev.wall_s;
   r.status = device_status(r.totals, r.bare ? &*r.bare : nullptr, p, r.info, r.scalar);
 
-  // The run's folder: timeseries.csv, then summary.json (the file that says the
-  // run is complete) last; a timeseries.csv of an earlier run is removed.
+  // The run's folder: the timeseries, then summary.json (the file that says the
+  // run is complete) last; a timeseries of an earlier run is removed.
   if (out) {
     std::vector<std::string> written{"summary.json"};
     if (series) {
-      write_timeseries(out->file("timeseries.csv"), scene, dev, has_device ? &bare : nullptr);
-      written.push_back("timeseries.csv");
+      const char* name = scene.output.format == TimeseriesFormat::kNpy ? "timeseries.npy" : "timeseries.csv";
+      write_timeseries(out->file(name), scene, dev, has_device ? &bare : nullptr);
+      written.push_back(name);
     }
     write_file_atomic(out->file("summary.json"), r.to_json().dump(2) + '\n');
     out->finish(written);

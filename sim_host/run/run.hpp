@@ -1,5 +1,5 @@
 // `vines run`: one scene on one record, with the bare frame alongside when the
-// scene has a device; writes DIR/summary.json and DIR/timeseries.csv.
+// scene has a device; writes DIR/summary.json and DIR/timeseries.csv (or .npy).
 #pragma once
 
 #include <cstddef>

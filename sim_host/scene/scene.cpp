@@ -31,7 +31,7 @@
 //             contact_scheme = "adaptive" | "bounded" | "split", bounded_substeps,
 //             split_steps, scalar = "double" | "float" | "fixed",
 //             fixed_accel_mps2, fixed_amplification, fixed_contact_speed_mps
-//   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries
+//   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries, format (csv, npy)
 //
 // Rules:
 // - Unknown tables and keys are errors; so is a value of the wrong type. An
@@ -233,6 +233,7 @@ void read_loop(const Section& s, LoopParams* l, FixedParams* f, Scalar* scalar) 
 // ---- [output] (host only; needs a validated sensor rate) ----
 void read_output(const Section& s, double sensor_rate_hz, OutputSpec* o) {
   s.read("timeseries", &o->timeseries);
+  s.choose<TimeseriesFormat>("format", {{"csv", TimeseriesFormat::kCsv}, {"npy", TimeseriesFormat::kNpy}}, &o->format);
   const std::string which = s.read("rate_hz", &o->rate_hz) ? "" : " (the default)";
   std::ostringstream sensor;
   sensor << "loop.sensor_rate_hz = " << sensor_rate_hz;
@@ -289,7 +290,7 @@ const std::initializer_list<std::string_view> kLoopKeys = {
     "sensor_rate_hz", "contact_rtol",   "max_substeps_per_step", "contact_count_depth_m", "energy_ledger",
     "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "split_steps",
     "scalar",         "fixed_accel_mps2",   "fixed_amplification", "fixed_contact_speed_mps"};
-const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries"};
+const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries", "format"};
 }  // namespace
 
 bool is_scene_key(const std::string& dotted) {

@@ -14,9 +14,14 @@
 
 namespace vines::host {
 
+// timeseries.csv (text, every number in its shortest exact form) or
+// timeseries.npy (NumPy, the values' bytes): the same columns and values.
+enum class TimeseriesFormat { kCsv, kNpy };
+
 struct OutputSpec {
   double rate_hz = 100.0;  // timeseries rows per second of record (<= sensor rate)
   bool timeseries = true;
+  TimeseriesFormat format = TimeseriesFormat::kCsv;
 };
 
 struct Scene {

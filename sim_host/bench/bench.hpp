@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim_host/reference/truth.hpp"
 #include "sim_host/scene/scene.hpp"
 
 namespace vines::host {
@@ -68,10 +69,37 @@ struct BenchOptions {
   std::vector<double> baseline_rtols;
   // Which baselines ("dop853", "cvode-adams", "cvode-bdf"); empty: all three.
   std::vector<std::string> baseline_methods;
+  int threads = 0;  // the ensemble's references (0: all cores); the timed runs are one at a time
 };
 
 // The baseline methods by name, in table order.
 extern const char* const kBaselineMethods[4];
+
+// One firmware setting of the table: scalar, sensor rate, contact tolerance,
+// contact scheme and its budget (bounded: sub-steps a step, split:
+// Runge-Kutta steps a contact scale, adaptive: 0).
+struct FirmwareSetting {
+  Scalar scalar = Scalar::kDouble;
+  double rate_hz = 0, rtol = 0;
+  ContactScheme scheme = ContactScheme::kAdaptive;
+  int budget = 0;
+};
+// One baseline setting: method (kBaselineMethods) and tolerance.
+struct BaselineSetting {
+  std::string method;
+  double rtol = 0;
+};
+
+// The settings the options ask for on a scene, in table order (throws
+// std::runtime_error naming the option at fault).
+std::vector<FirmwareSetting> firmware_settings(const Scene& scene, const BenchOptions& opt);
+std::vector<BaselineSetting> baseline_settings(const BenchOptions& opt);
+// The scene at a setting (only the outputs the table needs, unless
+// opt.full_outputs).
+Scene with_setting(const Scene& base, const FirmwareSetting& set, const BenchOptions& opt);
+const char* scheme_name(ContactScheme s);
+// The baseline method of a name of kBaselineMethods (throws naming --baseline-methods).
+reference::Method baseline_method(const std::string& name);
 
 // The scene's reference, or an unknown truth if there is none on file.
 Truth load_truth(const Scene& scene, const std::string& reference_dir);

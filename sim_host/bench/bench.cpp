@@ -1,4 +1,4 @@
-#include "sim_host/studies/bench.hpp"
+#include "sim_host/bench/bench.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -55,30 +55,13 @@ void set_errors(const Truth& truth, BenchLine* l) {
   l->x_r_abs_error = truth.known && truth.has_x_r ? std::fabs(l->x_r - truth.x_r) : kNaN;
 }
 
-const char* scheme_name(ContactScheme s) {
-  switch (s) {
-    case ContactScheme::kBounded: return "bounded";
-    case ContactScheme::kSplit: return "split";
-    default: return "adaptive";
-  }
-}
-
-// One firmware line: the scene at one scalar, rate and tolerance, with a
-// contact scheme and its budget (bounded: loop.bounded_substeps, split:
-// loop.split_steps; adaptive: none).
-BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rtol, ContactScheme cs, int budget,
-                        const Truth& truth, const BenchOptions& opt) {
-  Scene scene = base;
-  scene.scalar = scalar;
-  scene.params.loop.sensor_rate_hz = rate;
-  scene.params.loop.contact_rtol = rtol;
-  scene.params.loop.contact_scheme = cs;
-  if (cs == ContactScheme::kBounded) scene.params.loop.bounded_substeps = budget;
-  if (cs == ContactScheme::kSplit) scene.params.loop.split_steps = budget;
-  if (!opt.full_outputs) {
-    scene.params.loop.floor_peaks = false;
-    scene.params.loop.energy_ledger = false;
-  }
+// One firmware line: the scene at one setting.
+BenchLine firmware_line(const Scene& base, const FirmwareSetting& set, const Truth& truth, const BenchOptions& opt) {
+  const Scene scene = with_setting(base, set, opt);
+  const Scalar scalar = set.scalar;
+  const double rate = set.rate_hz, rtol = set.rtol;
+  const ContactScheme cs = set.scheme;
+  const int budget = set.budget;
   const Excitation ex = load_excitation(scene, "");
 
   BenchLine l;
@@ -118,14 +101,6 @@ BenchLine firmware_line(const Scene& base, Scalar scalar, double rate, double rt
   return l;
 }
 
-reference::Method baseline_method(const std::string& name) {
-  if (name == "dop853") return reference::Method::kDop853;
-  if (name == "dop853-driver") return reference::Method::kDop853Driver;
-  if (name == "cvode-adams") return reference::Method::kCvodeAdams;
-  if (name == "cvode-bdf") return reference::Method::kCvodeBdf;
-  throw std::runtime_error("--baseline-methods: unknown method '" + name +
-                           "' (dop853, dop853-driver, cvode-adams, cvode-bdf)");
-}
 
 // One baseline line (DOP853 in double or CVODE) on the record's own points.
 BenchLine baseline_line(const Scene& base, const std::string& method, double rtol, const Truth& truth,
@@ -161,6 +136,23 @@ BenchLine baseline_line(const Scene& base, const std::string& method, double rto
 
 const char* const kBaselineMethods[4] = {"dop853", "dop853-driver", "cvode-adams", "cvode-bdf"};
 
+reference::Method baseline_method(const std::string& name) {
+  if (name == "dop853") return reference::Method::kDop853;
+  if (name == "dop853-driver") return reference::Method::kDop853Driver;
+  if (name == "cvode-adams") return reference::Method::kCvodeAdams;
+  if (name == "cvode-bdf") return reference::Method::kCvodeBdf;
+  throw std::runtime_error("--baseline-methods: unknown method '" + name +
+                           "' (dop853, dop853-driver, cvode-adams, cvode-bdf)");
+}
+
+const char* scheme_name(ContactScheme s) {
+  switch (s) {
+    case ContactScheme::kBounded: return "bounded";
+    case ContactScheme::kSplit: return "split";
+    default: return "adaptive";
+  }
+}
+
 Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   const fs::path dir = reference_dir.empty() ? fs::path(VINES_SOURCE_DIR) / "data" / "reference" : fs::path(reference_dir);
   const fs::path file = dir / (safe_file_name(scene.name) + ".json");  // as vines reference names it
@@ -186,8 +178,7 @@ Truth load_truth(const Scene& scene, const std::string& reference_dir) {
   return t;
 }
 
-std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) {
-  const Truth truth = load_truth(scene, opt.reference_dir);
+std::vector<FirmwareSetting> firmware_settings(const Scene& scene, const BenchOptions& opt) {
   std::vector<Scalar> scalars;
   for (const std::string& s : opt.scalars.empty() ? std::vector<std::string>{"double", "float"} : opt.scalars) {
     if (s != "double" && s != "float" && s != "fixed")
@@ -206,7 +197,7 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
   const std::vector<int> budgets = opt.bounded_substeps.empty() ? std::vector<int>{loop.bounded_substeps}
                                                                  : opt.bounded_substeps;
   const std::vector<int> splits = opt.split_steps.empty() ? std::vector<int>{loop.split_steps} : opt.split_steps;
-  std::vector<BenchLine> lines;
+  std::vector<FirmwareSetting> out;
   for (Scalar s : scalars)
     for (double rate : rates)
       for (const std::string& scheme : schemes) {
@@ -216,25 +207,52 @@ std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) 
           continue;
         }
         if (scheme == "adaptive") {
-          for (double rtol : rtols)
-            lines.push_back(firmware_line(scene, s, rate, rtol, ContactScheme::kAdaptive, 0, truth, opt));
+          for (double rtol : rtols) out.push_back({s, rate, rtol, ContactScheme::kAdaptive, 0});
         } else if (scheme == "bounded" || scheme == "split") {
           const bool bounded = scheme == "bounded";
           for (int k : bounded ? budgets : splits)
             if (contacts || k == (bounded ? budgets : splits).front())
-              lines.push_back(firmware_line(scene, s, rate, loop.contact_rtol,
-                                            bounded ? ContactScheme::kBounded : ContactScheme::kSplit, k, truth, opt));
+              out.push_back({s, rate, loop.contact_rtol, bounded ? ContactScheme::kBounded : ContactScheme::kSplit, k});
         } else {
           throw std::runtime_error("--schemes: unknown contact scheme '" + scheme + "' (adaptive, bounded, split)");
         }
       }
-  // Baselines in table order, whatever the order asked.
+  return out;
+}
+
+Scene with_setting(const Scene& base, const FirmwareSetting& set, const BenchOptions& opt) {
+  Scene scene = base;
+  scene.scalar = set.scalar;
+  LoopParams& loop = scene.params.loop;
+  loop.sensor_rate_hz = set.rate_hz;
+  loop.contact_rtol = set.rtol;
+  loop.contact_scheme = set.scheme;
+  if (set.scheme == ContactScheme::kBounded) loop.bounded_substeps = set.budget;
+  if (set.scheme == ContactScheme::kSplit) loop.split_steps = set.budget;
+  if (!opt.full_outputs) {
+    loop.floor_peaks = false;
+    loop.energy_ledger = false;
+  }
+  return scene;
+}
+
+std::vector<BaselineSetting> baseline_settings(const BenchOptions& opt) {
   for (const std::string& m : opt.baseline_methods) baseline_method(m);
+  std::vector<BaselineSetting> out;
   for (const char* m : kBaselineMethods) {
     const auto& asked = opt.baseline_methods;
     if (!asked.empty() && std::find(asked.begin(), asked.end(), m) == asked.end()) continue;
-    for (double rtol : opt.baseline_rtols) lines.push_back(baseline_line(scene, m, rtol, truth, opt));
+    for (double rtol : opt.baseline_rtols) out.push_back({m, rtol});
   }
+  return out;
+}
+
+std::vector<BenchLine> bench_scene(const Scene& scene, const BenchOptions& opt) {
+  const Truth truth = load_truth(scene, opt.reference_dir);
+  std::vector<BenchLine> lines;
+  for (const FirmwareSetting& set : firmware_settings(scene, opt)) lines.push_back(firmware_line(scene, set, truth, opt));
+  // Baselines in table order, whatever the order asked.
+  for (const BaselineSetting& b : baseline_settings(opt)) lines.push_back(baseline_line(scene, b.method, b.rtol, truth, opt));
   return lines;
 }
 
