@@ -75,10 +75,10 @@ struct Poly {
 
 // A root of p in (lo, hi]: sign * p <= 0 at lo, > 0 at hi, narrowed by
 // Illinois (bisecting when the secant leaves the bracket or stalls) to tol.
-struct Bracket {
+struct Root {
   double lo, hi;
 };
-Bracket locate(const Poly& p, double lo, double hi, double sign, double tol) {
+Root locate(const Poly& p, double lo, double hi, double sign, double tol) {
   double glo = sign * p.at(lo), ghi = sign * p.at(hi), width = hi - lo;
   int last = 0;
   for (int it = 0; it < 300 && hi - lo > tol; ++it) {
@@ -360,7 +360,7 @@ class TunedRun {
   }
   void monitor(double te, const Vec& ye) {
     tally_.peak(std::fabs(ode_.top_x(ye.data())), time(s0_ + te * h_));
-    zeros(v_top_, te, [this](Bracket b) {
+    zeros(v_top_, te, [this](Root b) {
       ++tally_.r.events;
       const Poly x = along(x_top_);
       const double xl = std::fabs(x.at(b.lo)), xh = std::fabs(x.at(b.hi));
@@ -369,7 +369,7 @@ class TunedRun {
     if (!in_contact(mode_)) return;
     const int i = mode_ == Mode::kContactLeft ? 0 : 1;
     tally_.overlap(at(overlap_[i], ye));
-    zeros(rate_[i], te, [this, i](Bracket b) {
+    zeros(rate_[i], te, [this, i](Root b) {
       ++tally_.r.events;
       const Poly d = along(overlap_[i]);
       tally_.overlap(std::max(d.at(b.lo), d.at(b.hi)));
