@@ -286,7 +286,7 @@ json line_json(const BenchLine& l) {
 std::string format_table(const std::vector<BenchLine>& lines) {
   std::string out;
   char buf[320];
-  std::snprintf(buf, sizeof buf, "%-26s %-12s %-10s %-6s %8s %7s %10s %5s %8s %8s %7s %9s %9s %9s %8s\n", "scene",
+  std::snprintf(buf, sizeof buf, "%-26s %-13s %-10s %-6s %8s %7s %10s %5s %8s %8s %7s %9s %9s %9s %8s\n", "scene",
                 "method", "scheme", "scalar", "rate_hz", "rtol", "wall_ms", "runs", "steps", "substeps", "max_sub",
                 "peak_err", "Ee_err", "x_r_err", "contacts");
   out += buf;
@@ -295,7 +295,7 @@ std::string format_table(const std::vector<BenchLine>& lines) {
     if (l.method == "firmware")
       std::snprintf(scheme, sizeof scheme, l.budget > 0 ? "%s/%d" : "%s", l.scheme.c_str(), l.budget);
     std::snprintf(buf, sizeof buf,
-                  "%-26s %-12s %-10s %-6s %8.0f %7.3g %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
+                  "%-26s %-13s %-10s %-6s %8.0f %7.3g %10.4f %5d %8lld %8lld %7lld %9.2e %9.2e %9.2e %8d\n",
                   l.scene.c_str(), l.method.c_str(), scheme, l.scalar.c_str(), l.rate_hz, l.rtol,
                   1e3 * l.wall_median_s, l.runs, l.steps, l.substeps, l.max_substeps_in_step, l.peak_rel_error,
                   l.elastic_energy_rel_error, l.x_r_abs_error, l.contacts);

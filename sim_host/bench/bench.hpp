@@ -30,7 +30,7 @@ struct Truth {
 
 // One line of the work-precision table.
 struct BenchLine {
-  std::string scene, method, scalar;  // method: "firmware", "dop853", "cvode-adams", "cvode-bdf"
+  std::string scene, method, scalar;  // method: "firmware" or one of kBaselineMethods
   // Firmware lines: the contact scheme ("adaptive", "bounded", "split") and
   // its budget (bounded: sub-steps a step, split: Runge-Kutta steps a
   // contact scale, else 0); the most sub-steps any step took.
@@ -67,7 +67,7 @@ struct BenchOptions {
   // Baselines on the same model at these tolerances, fed the record's own
   // points (the same piecewise-linear input); empty: none.
   std::vector<double> baseline_rtols;
-  // Which baselines ("dop853", "cvode-adams", "cvode-bdf"); empty: all three.
+  // Which baselines (kBaselineMethods); empty: all four.
   std::vector<std::string> baseline_methods;
   int threads = 0;  // the ensemble's references (0: all cores); the timed runs are one at a time
 };

@@ -280,14 +280,7 @@ class TunedRun {
   double tol() const { return 16.0 * std::numeric_limits<double>::epsilon() * (t0_ + s0_ + h_) / h_; }
 
   // ---- mode events: g crosses zero upwards ----
-  int candidates(int out[2]) const {
-    if (!ode_.has_particle()) return 0;
-    switch (mode_) {
-      case Mode::kFree: out[0] = -1, out[1] = 1; return 2;
-      case Mode::kContactLeft: case Mode::kStuckLeft: out[0] = -1; return 1;
-      default: out[0] = 1; return 1;
-    }
-  }
+  int candidates(int out[2]) const { return ode_.has_particle() ? event_walls(mode_, out) : 0; }
   // Free: overlap beyond the start depth; contact: overlap back to 0;
   // riding: the wall would have to pull.
   const Affine& event_g(int side) const {

@@ -80,6 +80,16 @@ bool take_event(Mode& mode, int side, const SceneOde<T>& ode, T* y, Tally& tally
   return vines::take_event(mode, side, ode.restitution(), act);
 }
 
+// The walls whose event can come next in `mode`: both in free flight, the
+// one in contact or ridden; returns how many (into out).
+inline int event_walls(Mode mode, int out[2]) {
+  switch (mode) {
+    case Mode::kFree: out[0] = -1, out[1] = 1; return 2;
+    case Mode::kContactLeft: case Mode::kStuckLeft: out[0] = -1; return 1;
+    default: out[0] = 1; return 1;
+  }
+}
+
 // DOP853 with event location in scalar T (long double: the reference;
 // double: the `dop853-driver` baseline); instantiated for those two.
 template <typename T>

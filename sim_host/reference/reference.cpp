@@ -73,14 +73,7 @@ class ReferenceRun {
 
   // ---- mode events: g crosses zero upwards ----
   // Candidates: both walls in free flight, the wall in contact or riding.
-  int candidates(int out[2]) const {
-    if (!ode_.has_particle()) return 0;
-    switch (mode_) {
-      case Mode::kFree: out[0] = -1, out[1] = 1; return 2;
-      case Mode::kContactLeft: case Mode::kStuckLeft: out[0] = -1; return 1;
-      default: out[0] = 1; return 1;
-    }
-  }
+  int candidates(int out[2]) const { return ode_.has_particle() ? event_walls(mode_, out) : 0; }
   // Free: overlap beyond the start depth; contact: overlap back to 0;
   // riding: the wall would have to pull.
   T event_g(const T* y, int side) const {
