@@ -157,9 +157,10 @@ EnsembleLine baseline_line(const std::vector<EnsembleMember>& members, const std
   reference::Options o;
   o.rtol = set.rtol;
   // A member the method fails on (CVODE's root finding can give up) is
-  // reported and counted, not timed: the line's figures are over the rest.
-  std::vector<bool> told(members.size(), false);
+  // reported once, counted, and not run again in the later timing passes:
+  // the line's figures are over the rest.
   l.run_s = time_members(members.size(), opt, [&](std::size_t m) {
+    if (out[m].failed) return 0.0;
     const MemberTruth& t = truth[m];
     try {
       const reference::Result r =
@@ -167,10 +168,8 @@ EnsembleLine baseline_line(const std::vector<EnsembleMember>& members, const std
       out[m] = {r.peak_top, r.elastic_energy, r.contacts, false};
       return r.wall_s;
     } catch (const std::runtime_error& e) {
-      if (!told[m])
-        std::fprintf(stderr, "vines bench: %s at rtol %g failed on member %s: %s\n", set.method.c_str(), set.rtol,
-                     members[m].label.c_str(), e.what());
-      told[m] = true;
+      std::fprintf(stderr, "vines bench: %s at rtol %g failed on member %s: %s\n", set.method.c_str(), set.rtol,
+                   members[m].label.c_str(), e.what());
       out[m].failed = true;
       return 0.0;
     }
