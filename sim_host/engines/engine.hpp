@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,23 @@ struct Probe {
   double overlap = 0;   // how far the particle is past the nearer wall now [m] (< 0: still short of it)
 };
 
+// A physical state to put the loop in (Engine::set_physical), in double, in
+// Snapshot's conventions. NaN leaves a quantity as it is: the default, so
+// set only what is known. x and v are all or nothing (their first `stories`
+// entries); the particle's and the TMD's fields apply to that device only
+// (NaN for any other).
+struct PhysicalState {
+  static constexpr double kKeep = std::numeric_limits<double>::quiet_NaN();
+  static constexpr FloorArray keep_floors() {
+    FloorArray a{};
+    for (double& e : a) e = kKeep;
+    return a;
+  }
+  FloorArray x = keep_floors(), v = keep_floors();  // floors relative to ground [m, m/s]
+  double particle_x = kKeep, particle_v = kKeep;    // VI NES centre relative to ground, from the box centre at rest
+  double tmd_x = kKeep, tmd_v = kKeep;              // TMD relative to ground
+};
+
 class Engine {
  public:
   virtual ~Engine() = default;
@@ -96,6 +114,25 @@ class Engine {
   virtual Snapshot snapshot() const = 0;
   virtual RunTotals totals() const = 0;
   virtual Probe probe() const = 0;
+
+  // The loop's whole state (the data block, bit for bit) as bytes behind a
+  // header: magic and version, scalar, story count, device, the block's size
+  // and a fingerprint of the model (FNV-1a 64 of model_image()). Loaded into
+  // an engine of the same model, stepping goes on bit for bit as it would
+  // have here.
+  virtual std::vector<std::uint8_t> state() const = 0;
+  // Restores a state() of this engine's model: empty on success, else why it
+  // was refused (not a loop state, truncated, another scalar, story count,
+  // device or model), the current state then untouched.
+  virtual std::string load_state(const std::uint8_t* p, std::size_t n) = 0;
+  // Puts the loop in a physical state (vines/set_state.hpp): the floors
+  // solved for the linear state in double, the VI NES particle in free
+  // flight, strictly between the walls. The clock, peaks and counters are
+  // kept, E_e so far too (it goes on from the new state); with the energy
+  // ledger, the change in stored energy counts as energy put in
+  // (Ledger::initial). Empty on success, else why it was refused (naming the
+  // field; the state is then untouched). Not in fixed point (refused).
+  virtual std::string set_physical(const PhysicalState& s) = 0;
 };
 
 // The engine for a scene's story count, device and law, or nullptr if this

@@ -4,21 +4,39 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include <Eigen/LU>
+
 #include "sim_host/engines/engine.hpp"
+#include "sim_host/engines/loop_state.hpp"
 #include "sim_host/engines/model_info.hpp"
 #include "vines/build_model.hpp"
 #include "vines/model_image.hpp"
+#include "vines/set_state.hpp"
 #include "vines/sim.hpp"
 
 namespace vines::host {
 
 template <typename S, int N, typename Dev>
 class EngineImpl final : public Engine {
+  using M = Model<S, N, Dev>;
+  using D = Data<S, N, Dev>;
+  // state() and load_state() copy the data block as bytes: it holds plain
+  // members and fixed-size Eigen matrices (values in place), no pointer,
+  // nothing it owns or must release, no virtual table. (Eigen's matrices
+  // have copy constructors, so the type is not trivially copyable in the
+  // standard's sense; byte copies of them are what Eigen's own copies do.)
+  static_assert(!std::is_polymorphic_v<D> && std::is_trivially_destructible_v<D> &&
+                    M::VecX::SizeAtCompileTime != Eigen::Dynamic && M::VecN::SizeAtCompileTime != Eigen::Dynamic,
+                "Data must be copyable as bytes");
+  static constexpr Scalar kScalar = std::is_same_v<S, float> ? Scalar::kFloat : Scalar::kDouble;
+
  public:
   ParamError build(const SceneParams& p) override { return build_model(p, model_.get()); }
   ParamError set_initial_conditions(const SceneParams& p) override {
@@ -114,7 +132,81 @@ class EngineImpl final : public Engine {
     return r;
   }
 
+  // The header (loop_state.hpp) and the data block.
+  std::vector<std::uint8_t> state() const override { return loop_state::write(header(), {{data_.get(), sizeof(D)}}); }
+
+  std::string load_state(const std::uint8_t* p, std::size_t n) override {
+    std::string why = loop_state::check(header(), p, n);
+    if (why.empty()) loop_state::read(p, {{static_cast<void*>(data_.get()), sizeof(D)}});
+    return why;
+  }
+
+  // The floors solved for the position (velocity) coordinates in double:
+  // pos_map's first N columns (the mode shapes in modal form, the identity
+  // in the TMD's physical form), LU; then vines::set_state in S.
+  std::string set_physical(const PhysicalState& ps) override {
+    const M& m = *model_;
+    constexpr int P = M::kP;
+    typename M::VecX z = data_->z;
+    const auto solve = [&](const FloorArray& f, const char* name, int at) -> std::string {
+      int given = 0;
+      for (int i = 0; i < N; ++i) given += std::isnan(f[i]) ? 0 : 1;
+      if (given == 0) return {};
+      Eigen::Matrix<double, N, 1> b;
+      for (int i = 0; i < N; ++i) {
+        if (std::isnan(f[i]))
+          return std::string(name) + ": give all " + std::to_string(N) + " floors or none (floor " +
+                 std::to_string(i + 1) + " is NaN, " + std::to_string(given) + " are not)";
+        if (!std::isfinite(f[i])) return std::string(name) + ": floor " + std::to_string(i + 1) + " is not finite";
+        b(i) = f[i];
+      }
+      const Eigen::Matrix<double, N, N> map = m.pos_map.template leftCols<N>().template cast<double>();
+      const Eigen::PartialPivLU<Eigen::Matrix<double, N, N>> lu(map);
+      z.template segment<N>(at) = lu.solve(b).template cast<S>();
+      return {};
+    };
+    std::string why = solve(ps.x, "x", 0);
+    if (why.empty()) why = solve(ps.v, "v", P);
+    if (!why.empty()) return why;
+    // One of the device's quantities into *to, if given.
+    const auto take = [&](double value, const char* name, bool has, S* to, double offset = 0) -> std::string {
+      if (std::isnan(value)) return {};
+      if (!has) return std::string(name) + ": this model has no such device (leave it NaN)";
+      if (!std::isfinite(value)) return std::string(name) + ": not finite";
+      *to = static_cast<S>(value - offset);
+      return {};
+    };
+    constexpr bool kTmd = Dev::kKind == DeviceKind::kTmd, kVines = Dev::kKind == DeviceKind::kVines;
+    S tx = z(P - 1), tv = z(2 * P - 1), s = data_->s, sd = data_->sd;
+    double y0 = 0;
+    if constexpr (kVines) y0 = static_cast<double>(m.dev.y0);
+    for (const std::string& w : {take(ps.tmd_x, "tmd_x", kTmd, &tx), take(ps.tmd_v, "tmd_v", kTmd, &tv),
+                                 take(ps.particle_x, "particle_x", kVines, &s, y0),
+                                 take(ps.particle_v, "particle_v", kVines, &sd)})
+      if (!w.empty()) return w;
+    if constexpr (kTmd) {
+      z(N) = tx;
+      z(2 * N + 1) = tv;
+    }
+    if constexpr (kVines) {
+      const S xf = m.dev_x(z);
+      if (!particle_clear(m, s, xf)) {
+        const double at = static_cast<double>(xf), gap = m.dev.design.gap;
+        char msg[256];
+        std::snprintf(msg, sizeof msg,
+                      "particle_x: %.9g m is not strictly between the walls (%.9g m and %.9g m, where the "
+                      "centre touches them, the device floor at %.9g m)",
+                      y0 + static_cast<double>(s), at - gap, at + gap, at);
+        return msg;
+      }
+    }
+    const char* refused = vines::set_state(m, *data_, z, s, sd);
+    return refused ? refused : std::string();
+  }
+
  private:
+  loop_state::Header header() const { return loop_state::header_of<N, Dev>(kScalar, sizeof(D), model_image()); }
+
   // Heap on the host (the blocks can be large); the firmware keeps them static.
   std::unique_ptr<Model<S, N, Dev>> model_ = std::make_unique<Model<S, N, Dev>>();
   std::unique_ptr<Data<S, N, Dev>> data_ = std::make_unique<Data<S, N, Dev>>();

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "sim_host/engines/engine.hpp"
+#include "sim_host/engines/loop_state.hpp"
 #include "sim_host/engines/model_info.hpp"
 #include "vines/build_model.hpp"
 #include "vines/contact_laws.hpp"
@@ -42,6 +43,11 @@ class FixedEngine final : public Engine {
   using DModel = Model<double, N, Dev>;
   using DData = Data<double, N, Dev>;
   static constexpr int P = DModel::kP;
+  // state() and load_state() copy the node data as bytes: plain members and
+  // fixed-size Eigen matrices, no pointer, nothing owned, no virtual table.
+  static_assert(!std::is_polymorphic_v<FD> && std::is_trivially_destructible_v<FD> &&
+                    std::is_trivially_copyable_v<fixed::SampleHold> && std::is_trivially_copyable_v<Counters>,
+                "the fixed engine's state must be copyable as bytes");
 
  public:
   ParamError build(const SceneParams& p) override {
@@ -172,7 +178,45 @@ class FixedEngine final : public Engine {
     return r;
   }
 
+  // The header (loop_state.hpp), the node data a board holds, then what this
+  // engine keeps beside it: counters, the sample hold, saturations, the
+  // floors' peaks and the strain increments.
+  std::vector<std::uint8_t> state() const override {
+    return loop_state::write(header(), {{fd_.get(), sizeof(FD)},
+                                        {&count_, sizeof count_},
+                                        {&hold_, sizeof hold_},
+                                        {&saturations_, sizeof saturations_},
+                                        {peaks_.data(), sizeof(double) * N},
+                                        {drifts_.data(), sizeof(double) * N},
+                                        {&strain_increments_, sizeof strain_increments_},
+                                        {&last_strain_, sizeof last_strain_}});
+  }
+  std::string load_state(const std::uint8_t* p, std::size_t n) override {
+    std::string why = loop_state::check(header(), p, n);
+    if (why.empty())
+      loop_state::read(p, {{static_cast<void*>(fd_.get()), sizeof(FD)},
+                           {&count_, sizeof count_},
+                           {&hold_, sizeof hold_},
+                           {&saturations_, sizeof saturations_},
+                           {peaks_.data(), sizeof(double) * N},
+                           {drifts_.data(), sizeof(double) * N},
+                           {&strain_increments_, sizeof strain_increments_},
+                           {&last_strain_, sizeof last_strain_}});
+    return why;
+  }
+  // The fixed step's state is scaled modes in Q3.28, its E_e and ledger its
+  // own: not set from outside.
+  std::string set_physical(const PhysicalState&) override {
+    return "set_physical: not available in fixed point (loop.scalar = \"fixed\"); state() and load_state() are: "
+           "run the scene in double or float to set a physical state";
+  }
+
  private:
+  static constexpr std::size_t kStateBytes = sizeof(FD) + sizeof(Counters) + sizeof(fixed::SampleHold) +
+                                             sizeof(std::int64_t) + sizeof(double) * (2 * N + 2);
+  loop_state::Header header() const {
+    return loop_state::header_of<N, Dev>(Scalar::kFixed, kStateBytes, model_image());
+  }
   const auto& fm_frame() const { return Of::frame(nm_->step); }
 
   Q sample(double a) { return hold_.take<Q>(a, fm_frame().sa); }
