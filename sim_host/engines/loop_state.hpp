@@ -128,8 +128,8 @@ inline std::string check(const Header& want, const std::uint8_t* p, std::size_t 
   }
   if (n < total) return "truncated: " + std::to_string(n) + " of " + std::to_string(total) + " bytes";
   if (n > total)
-    return "not a vines loop state: " + std::to_string(n - total) + " bytes past its end (" + std::to_string(total) +
-           " bytes)";
+    return "not a vines loop state: " + std::to_string(n - total) + (n - total == 1 ? " byte" : " bytes") +
+           " past its end (" + std::to_string(total) + " bytes)";
   return {};
 }
 
