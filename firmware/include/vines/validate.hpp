@@ -54,13 +54,13 @@ inline ParamError validate(const DeviceParams& d, int stories) {
   if (d.kind == DeviceKind::kNone) return {};
   if (d.floor < 0 || d.floor > stories)
     return {"device.floor", "must be between 1 and the story count (0 = top)"};
-  if (d.mass_kg != 0.0 && !finite_positive(d.mass_kg)) return {"device.mass_kg", "must be > 0"};
+  if (d.mass_kg != 0.0 && !finite_positive(d.mass_kg)) return {"device.mass_kg", "must be finite and > 0"};
   if (d.mass_kg == 0.0 && (!finite_positive(d.mass_ratio) || d.mass_ratio > 1.0))
     return {"device.mass_ratio", "must be in (0, 1]"};
   if (d.kind == DeviceKind::kTmd) {
     const TmdParams& t = d.tmd;
     const bool given_k = t.k_n_per_m != 0.0, given_c = t.c_ns_per_m != 0.0;
-    if (given_k && !finite_positive(t.k_n_per_m)) return {"tmd.k_n_per_m", "must be > 0"};
+    if (given_k && !finite_positive(t.k_n_per_m)) return {"tmd.k_n_per_m", "must be finite and > 0"};
     if (given_c && (!std::isfinite(t.c_ns_per_m) || t.c_ns_per_m < 0.0))
       return {"tmd.c_ns_per_m", "must be >= 0"};
     if (given_c && !given_k) return {"tmd.c_ns_per_m", "needs tmd.k_n_per_m as well"};
@@ -70,17 +70,17 @@ inline ParamError validate(const DeviceParams& d, int stories) {
     return {};
   }
   const VinesParams& v = d.vines;
-  if (v.radius_m != 0.0 && !finite_positive(v.radius_m)) return {"vines.radius_m", "must be > 0"};
-  if (!finite_positive(v.density_kg_m3)) return {"vines.density_kg_m3", "must be > 0"};
-  if (!finite_positive(v.young_pa)) return {"vines.young_pa", "must be > 0"};
-  if (!finite_positive(v.wall_young_pa)) return {"vines.wall_young_pa", "must be > 0"};
+  if (v.radius_m != 0.0 && !finite_positive(v.radius_m)) return {"vines.radius_m", "must be finite and > 0"};
+  if (!finite_positive(v.density_kg_m3)) return {"vines.density_kg_m3", "must be finite and > 0"};
+  if (!finite_positive(v.young_pa)) return {"vines.young_pa", "must be finite and > 0"};
+  if (!finite_positive(v.wall_young_pa)) return {"vines.wall_young_pa", "must be finite and > 0"};
   if (!(v.poisson > -1.0 && v.poisson < 0.5)) return {"vines.poisson", "must be in (-1, 0.5)"};
   if (!(v.wall_poisson > -1.0 && v.wall_poisson < 0.5))
     return {"vines.wall_poisson", "must be in (-1, 0.5)"};
   if (v.box_length_m != 0.0) {
-    if (!finite_positive(v.box_length_m)) return {"vines.box_length_m", "must be > 0"};
+    if (!finite_positive(v.box_length_m)) return {"vines.box_length_m", "must be finite and > 0"};
   } else if (!(std::isfinite(v.beta) && v.beta > 1.0)) {
-    return {"vines.beta", "must be > 1 (the box must be longer than the sphere)"};
+    return {"vines.beta", "must be a finite number > 1 (the box must be longer than the sphere)"};
   }
   // The law's own checks (eps, tau...).
   ParamError law_error{"vines.law", "is not a known contact law"};
