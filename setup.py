@@ -52,6 +52,7 @@ setup(
     install_requires=["numpy"],
     packages=["vines"],
     package_dir={"vines": "sim_host/python/vines"},
+    package_data={"vines": ["py.typed", "*.pyi"]},
     ext_modules=[Extension("vines._vines", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,

@@ -27,6 +27,7 @@ rest=(
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
   libsundials-dev                                # CVODE baseline (vines bench, tests)
   pybind11-dev python3-dev python3-pytest        # the Python package and its tests,
+  mypy python3-pandas                            # its typing (mypy --strict), DataFrames
   python3-venv python3-pip                       # its `pip install .` test,
   python3-nbclient python3-ipykernel             # the notebook examples/paper.ipynb
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks

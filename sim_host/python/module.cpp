@@ -9,6 +9,8 @@
 #include <toml++/toml.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -146,6 +148,18 @@ py::dict series_dict(const std::vector<Snapshot>& rows, int stories) {
 
 // Runs a scene (on its own record, or `record`), the GIL released while the
 // loop runs; returns the summary (summary.json's text) and the series.
+// The excitation of a record given as samples: its errors are RecordErrors
+// (a record too short for one step at the sensor rate), as a file's are.
+Excitation array_excitation(const PyScene& s, const PyRecord& record) {
+  try {
+    return excitation_from_record(s.scene, record.record);
+  } catch (const hal::RecordError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw hal::RecordError(e.what());
+  }
+}
+
 py::dict run(const PyScene& s, const PyRecord* record) {
   RunOptions opt;
   opt.keep_series = true;
@@ -154,7 +168,7 @@ py::dict run(const PyScene& s, const PyRecord* record) {
     Excitation ex;
     bool have_ex = false;
     if (record && !record->from_file) {
-      ex = excitation_from_record(s.scene, record->record);
+      ex = array_excitation(s, *record);
       have_ex = true;
     } else if (record) {
       opt.record_override = record->record.path;
@@ -174,7 +188,7 @@ py::dict run(const PyScene& s, const PyRecord* record) {
 // `record`) scaled and resampled to the sensor rate [m/s^2].
 py::array_t<double> samples(const PyScene& s, const PyRecord* record) {
   Excitation ex;
-  if (record && !record->from_file) ex = excitation_from_record(s.scene, record->record);
+  if (record && !record->from_file) ex = array_excitation(s, *record);
   else if (record) ex = load_excitation(s.scene, record->record.path, record->reading);
   else ex = load_excitation(s.scene, "");
   return py::array_t<double>(static_cast<py::ssize_t>(ex.samples.size()), ex.samples.data());
@@ -198,6 +212,7 @@ py::dict step_dict(const Snapshot& s, int stories) {
 struct PyLoop {
   std::unique_ptr<Engine> eng;
   int stories = 0;
+  bool ledger = false;  // loop.energy_ledger: totals has the balance's residual
   bool started = false;
 
   void require_started() const {
@@ -209,10 +224,11 @@ PyLoop make_loop(const PyScene& s) {
   PyLoop l;
   l.eng = build_engine(s.scene.params, s.scene.scalar, s.scene.path);
   l.stories = l.eng->info().stories;
+  l.ledger = s.scene.params.loop.energy_ledger;
   return l;
 }
 
-py::dict totals_dict(const RunTotals& t, int stories) {
+py::dict totals_dict(const RunTotals& t, int stories, bool ledger) {
   py::dict d;
   d["peak_top_displacement_m"] = t.peak_top;
   d["t_peak_top_s"] = t.t_peak_top;
@@ -224,6 +240,8 @@ py::dict totals_dict(const RunTotals& t, int stories) {
   d["steps"] = t.count.steps;
   d["bad_samples_held"] = t.count.bad_samples;
   d["divergences_rolled_back"] = t.count.divergences;
+  // summary.json's: the ledger's largest |residual| over the largest energy in.
+  d["energy_balance_residual"] = ledger ? py::object(py::float_(t.ledger.relative_residual())) : py::none();
   return d;
 }
 
@@ -239,6 +257,7 @@ PYBIND11_MODULE(_vines, m) {
   m.doc() = "vines core: scenes, records, runs (see the vines package)";
   py::register_exception<SceneError>(m, "SceneError", PyExc_ValueError);
   py::register_exception<hal::RecordError>(m, "RecordError", PyExc_ValueError);
+  m.attr("__version__") = VINES_VERSION;
 
   py::class_<PyScene>(m, "Scene")
       .def_static("load", [](const std::string& path) { return make_scene(read_scene_table(path), path); },
@@ -255,7 +274,9 @@ PYBIND11_MODULE(_vines, m) {
         os << s.table;
         return os.str() + "\n";
       })
+      .def("to_dict", [](const PyScene& s) { return to_dict(s.table); })
       .def_property_readonly("name", [](const PyScene& s) { return s.scene.name; })
+      .def_property_readonly("device", [](const PyScene& s) { return device_name(s.scene.params.device.kind); })
       .def_property_readonly("origin", [](const PyScene& s) { return s.origin; })
       .def_property_readonly("stories", [](const PyScene& s) { return s.scene.params.frame.stories; })
       .def_property_readonly("sensor_rate_hz", [](const PyScene& s) { return s.scene.params.loop.sensor_rate_hz; })
@@ -296,11 +317,54 @@ PYBIND11_MODULE(_vines, m) {
         }
         return step_dict(l.eng->snapshot(), l.stories);
       }, py::arg("samples"))
+      .def_property_readonly("started", [](const PyLoop& l) { return l.started; })
+      .def("now", [](const PyLoop& l) {
+        l.require_started();
+        return step_dict(l.eng->snapshot(), l.stories);
+      })
+      .def("state", [](const PyLoop& l) {
+        l.require_started();
+        const std::vector<std::uint8_t> b = l.eng->state();
+        return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
+      })
+      .def("load_state", [](PyLoop& l, const py::bytes& b) {
+        const std::string data = b;
+        const std::string why = l.eng->load_state(reinterpret_cast<const std::uint8_t*>(data.data()), data.size());
+        if (!why.empty()) throw std::invalid_argument("vines.Loop.set_state: " + why);
+        l.started = true;
+      }, py::arg("state"))
+      .def("set_physical", [](PyLoop& l, const py::dict& d) {
+        l.require_started();
+        PhysicalState p;
+        for (const auto& [k, v] : d) {
+          const std::string name = py::str(k);
+          if (name == "x" || name == "v") {
+            const auto a = v.cast<py::array_t<double, py::array::c_style | py::array::forcecast>>();
+            if (a.ndim() != 1 || a.shape(0) != l.stories)
+              throw std::invalid_argument("vines.Loop.set_state: " + name + ": one value a floor");
+            FloorArray& to = name == "x" ? p.x : p.v;
+            for (int j = 0; j < l.stories; ++j) to[static_cast<std::size_t>(j)] = a.at(j);
+          } else if (name == "particle_x") p.particle_x = v.cast<double>();
+          else if (name == "particle_v") p.particle_v = v.cast<double>();
+          else if (name == "tmd_x") p.tmd_x = v.cast<double>();
+          else if (name == "tmd_v") p.tmd_v = v.cast<double>();
+          else throw std::invalid_argument("vines.Loop.set_state: no field " + name);
+        }
+        const std::string why = l.eng->set_physical(p);
+        if (!why.empty()) throw std::invalid_argument("vines.Loop.set_state: " + why);
+      }, py::arg("fields"))
       .def_property_readonly("totals", [](const PyLoop& l) {
         l.require_started();
-        return totals_dict(l.eng->totals(), l.stories);
+        return totals_dict(l.eng->totals(), l.stories, l.ledger);
       });
 
+  m.def("find_record", [](const std::string& path) {
+    try {
+      return resolve_record_path(path, "vines.Record.load");
+    } catch (const SceneError& e) {
+      throw hal::RecordError(e.what());
+    }
+  }, py::arg("path"));
   m.def("run", &run, py::arg("scene"), py::arg("record") = nullptr);
   m.def("samples", &samples, py::arg("scene"), py::arg("record") = nullptr);
   m.def("modal", &modal, py::arg("scene"));

@@ -24,9 +24,12 @@ struct PyScene {
 };
 
 // Python values as TOML nodes: bool, int, float, str, list (or tuple), dict
-// (nested). `where` names the value in messages: "origin: section.key".
+// (nested; the package has made numpy values these). `where` names the
+// value in messages: "origin: section.key"; another type is a TypeError.
 toml::table to_table(const py::dict& d, const std::string& origin, const std::string& prefix);
 toml::array to_array(const py::handle l, const std::string& origin, const std::string& key);
+// A TOML table as nested Python dicts, lists and values (Scene.to_dict).
+py::dict to_dict(const toml::table& t);
 // Sets t[name] to the value v; key names it in messages.
 void insert(toml::table& t, const std::string& name, const py::handle v, const std::string& origin,
             const std::string& key);

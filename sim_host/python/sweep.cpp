@@ -34,12 +34,22 @@ py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, cons
   root.insert("study", std::move(studies));
   std::ostringstream text;
   text << root;
-  SweepSpec spec = parse_sweep(text.str(), origin);
-  spec.studies[0].scene_path = s.origin;
-  std::ostringstream scene;
-  scene << s.table;
-  spec.studies[0].scene_toml = scene.str();
-  const std::vector<RunPlan> plan = plan_runs(spec);
+  // The spec's errors (a key that is not a scene key, a bad range, a key
+  // set twice, group_by) are the scene's: SceneError, raised before any run.
+  SweepSpec spec;
+  std::vector<RunPlan> plan;
+  try {
+    spec = parse_sweep(text.str(), origin);
+    spec.studies[0].scene_path = s.origin;
+    std::ostringstream scene;
+    scene << s.table;
+    spec.studies[0].scene_toml = scene.str();
+    plan = plan_runs(spec);
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
   // The runs on their own thread, the GIL released; Python's signals are
   // checked every 0.1 s meanwhile: Ctrl-C stops the sweep (the runs under
   // way are dropped within a second) and raises KeyboardInterrupt.

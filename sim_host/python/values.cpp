@@ -1,5 +1,7 @@
 // Python values as TOML nodes, checked as a scene file's would be.
 #include <cstdint>
+#include <sstream>
+#include <utility>
 #include <string>
 
 #include "sim_host/python/module.hpp"
@@ -8,8 +10,8 @@ namespace vines::python {
 namespace {
 
 [[noreturn]] void bad_type(const std::string& where, const py::handle v) {
-  throw host::SceneError(where + ": a value of type " + std::string(py::str(v.get_type().attr("__name__"))) +
-                         " (bool, int, float, str, list or dict)");
+  throw py::type_error(where + ": a value of type " + std::string(py::str(v.get_type().attr("__name__"))) +
+                       " (bool, int, float, str, list or dict)");
 }
 
 }  // namespace
@@ -45,6 +47,29 @@ toml::table to_table(const py::dict& d, const std::string& origin, const std::st
     const std::string name = py::str(k);
     insert(out, name, v, origin, prefix.empty() ? name : prefix + "." + name);
   }
+  return out;
+}
+
+py::object to_python(const toml::node& n) {
+  if (const auto* t = n.as_table()) return to_dict(*t);
+  if (const auto* a = n.as_array()) {
+    py::list out;
+    for (const toml::node& item : *a) out.append(to_python(item));
+    return std::move(out);
+  }
+  if (const auto v = n.value_exact<bool>()) return py::bool_(*v);
+  if (const auto v = n.value_exact<std::int64_t>()) return py::int_(*v);
+  if (const auto v = n.value_exact<double>()) return py::float_(*v);
+  if (const auto v = n.value_exact<std::string>()) return py::str(*v);
+  // Dates and times: a scene has none; their TOML text if one appears.
+  std::ostringstream os;
+  n.visit([&](const auto& x) { os << x; });
+  return py::str(os.str());
+}
+
+py::dict to_dict(const toml::table& t) {
+  py::dict out;
+  for (const auto& [k, v] : t) out[py::str(std::string(k.str()))] = to_python(v);
   return out;
 }
 
