@@ -2,6 +2,7 @@
 // owns a Model and a Data block and copies outputs out in double.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -133,11 +134,11 @@ class EngineImpl final : public Engine {
   }
 
   // The header (loop_state.hpp) and the data block.
-  std::vector<std::uint8_t> state() const override { return loop_state::write(header(), {{data_.get(), sizeof(D)}}); }
+  std::vector<std::uint8_t> state() const override { return loop_state::write(header(), slots()); }
 
   std::string load_state(const std::uint8_t* p, std::size_t n) override {
     std::string why = loop_state::check(header(), p, n);
-    if (why.empty()) loop_state::read(p, {{static_cast<void*>(data_.get()), sizeof(D)}});
+    if (why.empty()) loop_state::read(p, slots());
     return why;
   }
 
@@ -205,6 +206,7 @@ class EngineImpl final : public Engine {
   }
 
  private:
+  std::array<loop_state::Slot, 1> slots() const { return {{{data_.get(), sizeof(D)}}}; }
   loop_state::Header header() const { return loop_state::header_of<N, Dev>(kScalar, sizeof(D), model_image()); }
 
   // Heap on the host (the blocks can be large); the firmware keeps them static.

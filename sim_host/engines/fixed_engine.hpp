@@ -13,6 +13,7 @@
 // counted (RunTotals::fixed_saturations).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -178,30 +179,12 @@ class FixedEngine final : public Engine {
     return r;
   }
 
-  // The header (loop_state.hpp), the node data a board holds, then what this
-  // engine keeps beside it: counters, the sample hold, saturations, the
-  // floors' peaks and the strain increments.
-  std::vector<std::uint8_t> state() const override {
-    return loop_state::write(header(), {{fd_.get(), sizeof(FD)},
-                                        {&count_, sizeof count_},
-                                        {&hold_, sizeof hold_},
-                                        {&saturations_, sizeof saturations_},
-                                        {peaks_.data(), sizeof(double) * N},
-                                        {drifts_.data(), sizeof(double) * N},
-                                        {&strain_increments_, sizeof strain_increments_},
-                                        {&last_strain_, sizeof last_strain_}});
-  }
+  // The header (loop_state.hpp), then slots(): the node data a board holds
+  // and what this engine keeps beside it.
+  std::vector<std::uint8_t> state() const override { return loop_state::write(header(), slots()); }
   std::string load_state(const std::uint8_t* p, std::size_t n) override {
     std::string why = loop_state::check(header(), p, n);
-    if (why.empty())
-      loop_state::read(p, {{static_cast<void*>(fd_.get()), sizeof(FD)},
-                           {&count_, sizeof count_},
-                           {&hold_, sizeof hold_},
-                           {&saturations_, sizeof saturations_},
-                           {peaks_.data(), sizeof(double) * N},
-                           {drifts_.data(), sizeof(double) * N},
-                           {&strain_increments_, sizeof strain_increments_},
-                           {&last_strain_, sizeof last_strain_}});
+    if (why.empty()) loop_state::read(p, slots());
     return why;
   }
   // The fixed step's state is scaled modes in Q3.28, its E_e and ledger its
@@ -216,6 +199,20 @@ class FixedEngine final : public Engine {
                                              sizeof(std::int64_t) + sizeof(double) * (2 * N + 2);
   loop_state::Header header() const {
     return loop_state::header_of<N, Dev>(Scalar::kFixed, kStateBytes, model_image());
+  }
+  // Where the state's blocks live: the node data, counters, the sample hold,
+  // saturations, the floors' peaks and drifts, the strain increments. Read by
+  // state() (const), written by load_state().
+  std::array<loop_state::Slot, 8> slots() const {
+    auto& e = const_cast<FixedEngine&>(*this);
+    return {{{e.fd_.get(), sizeof(FD)},
+             {&e.count_, sizeof count_},
+             {&e.hold_, sizeof hold_},
+             {&e.saturations_, sizeof saturations_},
+             {e.peaks_.data(), sizeof(double) * N},
+             {e.drifts_.data(), sizeof(double) * N},
+             {&e.strain_increments_, sizeof strain_increments_},
+             {&e.last_strain_, sizeof last_strain_}}};
   }
   const auto& fm_frame() const { return Of::frame(nm_->step); }
 

@@ -4,11 +4,11 @@
 // format to exchange).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <initializer_list>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -72,28 +72,28 @@ inline std::string engine_name(const Header& h) {
   return s;
 }
 
-// A state: the header, then each block's bytes in turn.
-struct Block {
-  const void* p;
-  std::size_t n;
-};
-inline std::vector<std::uint8_t> write(const Header& h, std::initializer_list<Block> blocks) {
-  std::vector<std::uint8_t> out(sizeof(Header) + h.block_bytes);
-  std::memcpy(out.data(), &h, sizeof(Header));
-  std::size_t at = sizeof(Header);
-  for (const Block& b : blocks) {
-    std::memcpy(out.data() + at, b.p, b.n);
-    at += b.n;
-  }
-  return out;
-}
-
-// Reads the blocks of a state check() accepted into their places, in turn.
+// Where an engine keeps one block of its state.
 struct Slot {
   void* p;
   std::size_t n;
 };
-inline void read(const std::uint8_t* p, std::initializer_list<Slot> slots) {
+
+// A state: the header, then each slot's bytes in turn.
+template <class Slots>
+std::vector<std::uint8_t> write(const Header& h, const Slots& slots) {
+  std::vector<std::uint8_t> out(sizeof(Header) + h.block_bytes);
+  std::memcpy(out.data(), &h, sizeof(Header));
+  std::size_t at = sizeof(Header);
+  for (const Slot& s : slots) {
+    std::memcpy(out.data() + at, s.p, s.n);
+    at += s.n;
+  }
+  return out;
+}
+
+// Reads the blocks of a state check() accepted into their slots, in turn.
+template <class Slots>
+void read(const std::uint8_t* p, const Slots& slots) {
   std::size_t at = sizeof(Header);
   for (const Slot& s : slots) {
     std::memcpy(s.p, p + at, s.n);
