@@ -22,7 +22,8 @@ def test_the_version_is_the_projects():
 
 @pytest.mark.parametrize("obj", [vines.run, vines.sweep, vines.samples, vines.modal, vines.Scene.load,
                                  vines.Scene.from_dict, vines.Scene.with_, vines.Record, vines.Record.load,
-                                 vines.Loop.set_state])
+                                 vines.Loop.set_state, vines.Loop.reset, vines.Loop.step, vines.Loop.run,
+                                 vines.Result.to_frame])
 def test_public_callables_have_numpydoc_sections(obj):
     doc = inspect.getdoc(obj)
     assert doc and ("Parameters\n----------" in doc or "Returns\n-------" in doc), obj

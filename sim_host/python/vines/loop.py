@@ -107,17 +107,54 @@ class Loop:
         return Step(blank_absent(d, self.scene.device))
 
     def reset(self, a0: float = 0.0) -> Step:
-        """Back to t = 0 (the scene's initial conditions), ground
-        acceleration `a0` [m/s^2]; the outputs at t = 0."""
+        """Back to t = 0, in the scene's initial conditions.
+
+        Parameters
+        ----------
+        a0 : float
+            The ground acceleration at t = 0 [m/s^2].
+
+        Returns
+        -------
+        Step
+            The outputs at t = 0.
+        """
         return self._step(self._impl.reset(float(a0)))
 
     def step(self, a_g: float) -> Step:
-        """One sensor period to the next sample `a_g` [m/s^2]; its outputs."""
+        """One sensor period on.
+
+        Parameters
+        ----------
+        a_g : float
+            The next ground acceleration sample [m/s^2]; a non-finite one
+            is held (the last good one used) and counted.
+
+        Returns
+        -------
+        Step
+            The outputs at the new time.
+
+        Raises
+        ------
+        RuntimeError
+            Before `reset` (or `set_state` with a saved state).
+        """
         return self._step(self._impl.step(float(a_g)))
 
     def run(self, samples: npt.ArrayLike) -> Step:
-        """Steps through every sample [m/s^2] (the loop in C++, the GIL
-        released); the last step's outputs."""
+        """Steps through many samples, the loop in C++ with the GIL released.
+
+        Parameters
+        ----------
+        samples : array_like
+            Ground acceleration samples [m/s^2], one a sensor period.
+
+        Returns
+        -------
+        Step
+            The last step's outputs.
+        """
         return self._step(self._impl.run(np.asarray(samples, dtype=float)))
 
     @property

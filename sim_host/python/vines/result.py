@@ -141,9 +141,24 @@ class Result:
         return bool(self.summary["status"] != "ok")
 
     def to_frame(self, bare: bool = False) -> Any:
-        """The device run's series as a pandas DataFrame indexed by t (see
-        `Series.to_frame`); with `bare`, the bare frame's x, v, acc and
-        drift too, as bare_x1, ... (timeseries.csv's columns)."""
+        """The device run's series as a pandas DataFrame.
+
+        Parameters
+        ----------
+        bare : bool
+            Add the bare frame's x, v, acc and drift as bare_x1, ...
+
+        Returns
+        -------
+        pandas.DataFrame
+            Indexed by t: ag, x1..xN, v1..vN, acc1..accN, drift1..driftN,
+            elastic_energy and the device's channels (see `Series.to_frame`).
+
+        Raises
+        ------
+        ImportError
+            Without pandas (Debian: python3-pandas).
+        """
         frame = self.series.to_frame()
         if bare and self.bare is not None:
             extra = {k: v for k, v in self.bare.__dict__.items() if k in FLOOR_CHANNELS}
