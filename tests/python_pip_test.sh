@@ -3,7 +3,8 @@
 # the venv's folder (a scratch one) and the build tree (the configured one
 # reused through VINES_BUILD_DIR, so the extension is not compiled twice);
 # the installed package, imported from outside the checkout, gives the same
-# run as the build tree's. No package index is used.
+# run as the build tree's and is typed (py.typed and the extension's stub). No
+# package index is used.
 # Usage: python_pip_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
 source_dir=$(cd "$1" && pwd)
@@ -22,7 +23,9 @@ done
 
 scene=$source_dir/data/scenes/elcentro_vines.toml
 check='
-import sys, vines
+import os, sys, vines
+here = os.path.dirname(vines.__file__)
+assert all(os.path.isfile(os.path.join(here, f)) for f in ("py.typed", "_vines.pyi")), "typing files missing"
 scene = vines.Scene.load(sys.argv[1])
 r = vines.run(scene.with_({"loop.sensor_rate_hz": 50.0, "output.rate_hz": 50.0}))
 print(vines.__file__)

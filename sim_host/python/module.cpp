@@ -10,8 +10,8 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -146,8 +146,6 @@ py::dict series_dict(const std::vector<Snapshot>& rows, int stories) {
   return d;
 }
 
-// Runs a scene (on its own record, or `record`), the GIL released while the
-// loop runs; returns the summary (summary.json's text) and the series.
 // The excitation of a record given as samples: its errors are RecordErrors
 // (a record too short for one step at the sensor rate), as a file's are.
 Excitation array_excitation(const PyScene& s, const PyRecord& record) {
@@ -160,6 +158,8 @@ Excitation array_excitation(const PyScene& s, const PyRecord& record) {
   }
 }
 
+// Runs a scene (on its own record, or `record`), the GIL released while the
+// loop runs; returns the summary (summary.json's text) and the series.
 py::dict run(const PyScene& s, const PyRecord* record) {
   RunOptions opt;
   opt.keep_series = true;

@@ -1,8 +1,8 @@
 // Python values as TOML nodes, checked as a scene file's would be.
 #include <cstdint>
 #include <sstream>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include "sim_host/python/module.hpp"
 
@@ -50,6 +50,8 @@ toml::table to_table(const py::dict& d, const std::string& origin, const std::st
   return out;
 }
 
+namespace {
+
 py::object to_python(const toml::node& n) {
   if (const auto* t = n.as_table()) return to_dict(*t);
   if (const auto* a = n.as_array()) {
@@ -66,6 +68,8 @@ py::object to_python(const toml::node& n) {
   n.visit([&](const auto& x) { os << x; });
   return py::str(os.str());
 }
+
+}  // namespace
 
 py::dict to_dict(const toml::table& t) {
   py::dict out;

@@ -44,6 +44,8 @@ def test_arrays_are_lists_in_dicts_and_grids(vi):
 def test_a_value_with_no_exact_double_is_refused(vi):
     with pytest.raises(TypeError, match="vines.beta.*no exact double"):
         vi.with_({"vines.beta": np.longdouble(4) / 3})
+    with pytest.raises(TypeError, match="vines.beta.*no exact double"):
+        vi.with_({"vines.beta": np.longdouble(10) ** 400})  # would be inf as a double
     with pytest.raises(TypeError, match=r"vines\.law: a value of type object \(bool, int, float, str"):
         vi.with_({"vines.law": object()})
     with pytest.raises(TypeError, match="device.kind"):

@@ -1,7 +1,6 @@
-"""Python and numpy values as the plain values a scene, a study or a record
-takes (bool, int, float, str, list, dict), converted exactly; and the
-objects the entry points take (a Scene or a path, a Record, a path or
-(samples, dt)), with a TypeError naming what was expected otherwise."""
+"""Python and numpy values as the plain values a scene or a study takes
+(bool, int, float, str, list, dict), converted exactly, and paths as str;
+a TypeError naming what was expected otherwise."""
 
 from __future__ import annotations
 
@@ -27,7 +26,7 @@ def _number(value: Any, where: str) -> Plain:
         return int(value)
     if isinstance(value, (float, np.floating)):
         f = float(value)
-        if math.isfinite(f) and np.longdouble(f) != np.longdouble(value):
+        if not math.isnan(f) and np.longdouble(f) != np.longdouble(value):  # rounded, or overflowed to inf
             raise TypeError("%s: %r has no exact double value" % (where, value))
         return f
     raise TypeError("%s: a value of type %s (%s)" % (where, type(value).__name__, _EXPECTED))
