@@ -165,6 +165,30 @@ TEST(LoopState, RefusesOtherStates) {
   EXPECT_EQ(eng->load_state(own.data(), own.size()), "");
 }
 
+// The model's fingerprint is cached (loop_state::Fingerprint) but follows
+// the model: new initial conditions, a rebuild or a loaded image make the
+// states saved before them another model's, and back again.
+TEST(LoopState, TheFingerprintFollowsTheModel) {
+  const SceneParams p = test::paper_scene(DeviceKind::kVines);
+  SceneParams elsewhere = p;
+  elsewhere.device.vines.start_at_left_wall = false;
+  elsewhere.device.vines.initial_position_m = 0.01;
+  for (Scalar scalar : {Scalar::kDouble, Scalar::kFixed}) {
+    SceneParams q = p, r = elsewhere;
+    if (scalar == Scalar::kFixed) q.loop.contact_scheme = r.loop.contact_scheme = ContactScheme::kSplit;
+    const auto eng = built(q, scalar);
+    eng->init(0);
+    const std::vector<std::uint8_t> before = eng->state(), image = eng->model_image();
+    ASSERT_TRUE(eng->set_initial_conditions(r).ok());
+    EXPECT_TRUE(has(eng->load_state(before.data(), before.size()), "another model")) << scalar_name(scalar);
+    ASSERT_TRUE(eng->build(q).ok());
+    EXPECT_EQ(eng->load_state(before.data(), before.size()), "") << scalar_name(scalar);
+    ASSERT_TRUE(eng->set_initial_conditions(r).ok());
+    ASSERT_EQ(eng->load_image(image.data(), image.size()), "");
+    EXPECT_EQ(eng->load_state(before.data(), before.size()), "") << scalar_name(scalar);
+  }
+}
+
 // The physical state a snapshot reads, set.
 PhysicalState physical(const Snapshot& s, int stories, DeviceKind kind) {
   PhysicalState ps;

@@ -39,8 +39,12 @@ class EngineImpl final : public Engine {
   static constexpr Scalar kScalar = std::is_same_v<S, float> ? Scalar::kFloat : Scalar::kDouble;
 
  public:
-  ParamError build(const SceneParams& p) override { return build_model(p, model_.get()); }
+  ParamError build(const SceneParams& p) override {
+    fingerprint_.forget();
+    return build_model(p, model_.get());
+  }
   ParamError set_initial_conditions(const SceneParams& p) override {
+    fingerprint_.forget();
     return vines::set_initial_conditions(p.device, model_.get());
   }
 
@@ -58,6 +62,7 @@ class EngineImpl final : public Engine {
     if (!why) why = loader.finish();
     if (why) return why;
     model_ = std::move(fresh);
+    fingerprint_.forget();
     return {};
   }
 
@@ -207,11 +212,14 @@ class EngineImpl final : public Engine {
 
  private:
   std::array<loop_state::Slot, 1> slots() const { return {{{data_.get(), sizeof(D)}}}; }
-  loop_state::Header header() const { return loop_state::header_of<N, Dev>(kScalar, sizeof(D), model_image()); }
+  loop_state::Header header() const {
+    return loop_state::header_of<N, Dev>(kScalar, sizeof(D), fingerprint_.of(*this));
+  }
 
   // Heap on the host (the blocks can be large); the firmware keeps them static.
   std::unique_ptr<Model<S, N, Dev>> model_ = std::make_unique<Model<S, N, Dev>>();
   std::unique_ptr<Data<S, N, Dev>> data_ = std::make_unique<Data<S, N, Dev>>();
+  loop_state::Fingerprint fingerprint_;  // of model_ (loop states name it)
 };
 
 }  // namespace vines::host

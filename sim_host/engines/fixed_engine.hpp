@@ -52,6 +52,7 @@ class FixedEngine final : public Engine {
 
  public:
   ParamError build(const SceneParams& p) override {
+    fingerprint_.forget();
     if (kVines && p.loop.contact_scheme != ContactScheme::kSplit)
       return {"loop.contact_scheme", "loop.scalar = \"fixed\" runs the split contact scheme only: set it to \"split\""};
     if (kTmd && p.loop.energy_ledger)
@@ -69,6 +70,7 @@ class FixedEngine final : public Engine {
     return {};
   }
   ParamError set_initial_conditions(const SceneParams& p) override {
+    fingerprint_.forget();
     const ParamError e = vines::set_initial_conditions(p.device, dm_.get());
     if (e.ok()) fixed::build_node_model(*dm_, fixed_, nm_.get());
     return e;
@@ -89,6 +91,7 @@ class FixedEngine final : public Engine {
     if (!why) why = loader.finish();
     if (why) return why;
     nm_ = std::move(loaded);
+    fingerprint_.forget();
     return {};
   }
   ModelInfo info() const override { return model_info(*dm_); }
@@ -198,7 +201,7 @@ class FixedEngine final : public Engine {
   static constexpr std::size_t kStateBytes = sizeof(FD) + sizeof(Counters) + sizeof(fixed::SampleHold) +
                                              sizeof(std::int64_t) + sizeof(double) * (2 * N + 2);
   loop_state::Header header() const {
-    return loop_state::header_of<N, Dev>(Scalar::kFixed, kStateBytes, model_image());
+    return loop_state::header_of<N, Dev>(Scalar::kFixed, kStateBytes, fingerprint_.of(*this));
   }
   // Where the state's blocks live: the node data, counters, the sample hold,
   // saturations, the floors' peaks and drifts, the strain increments. Read by
@@ -298,6 +301,7 @@ class FixedEngine final : public Engine {
   std::unique_ptr<NM> nm_ = std::make_unique<NM>();
   std::unique_ptr<FD> fd_ = std::make_unique<FD>();
   std::unique_ptr<DData> shadow_ = std::make_unique<DData>();
+  loop_state::Fingerprint fingerprint_;  // of nm_ (loop states name it)
   FixedParams fixed_;
   Counters count_;
   fixed::SampleHold hold_;
