@@ -88,7 +88,9 @@ def sweep(scene: Any, grid: Optional[Mapping[str, Any]] = None, set: Optional[Ma
         Paired keys, ``[{"section.key": value, ...}, ...]``: the runs are
         the cases times the grid.
     group_by : str, optional
-        A grid key whose values run together (as [study] group_by).
+        A grid key, checked as [study] group_by is. The rows are per run
+        all the same: group them with numpy or pandas (the program's
+        per-group statistics of summary.json are not computed here).
     threads : int
         C++ threads (0: every core), with the GIL released; Ctrl-C stops
         the runs and raises KeyboardInterrupt.
