@@ -47,6 +47,12 @@ def _pandas() -> Any:
         raise ImportError("a DataFrame needs pandas (Debian: apt-get install python3-pandas)") from None
 
 
+def _frame(t: Array, columns: Mapping[str, Any]) -> Any:
+    """A pandas DataFrame of `columns`, indexed by t."""
+    pandas = _pandas()
+    return pandas.DataFrame(columns, index=pandas.Index(t, name="t"))
+
+
 class Series:
     """Time series at the scene's output rate.
 
@@ -90,7 +96,7 @@ class Series:
     def to_frame(self) -> Any:
         """A pandas DataFrame indexed by t: ag, x1..xN, v1..vN, acc1..accN,
         drift1..driftN, elastic_energy and the device's channels."""
-        return _pandas().DataFrame(frame_columns(self.__dict__), index=_pandas().Index(self.t, name="t"))
+        return _frame(self.t, frame_columns(self.__dict__))
 
     def __repr__(self) -> str:
         return "vines.Series(%d rows: %s)" % (len(self.t), ", ".join(sorted(self.__dict__)))
@@ -159,12 +165,11 @@ class Result:
         ImportError
             Without pandas (Debian: python3-pandas).
         """
-        frame = self.series.to_frame()
+        columns = frame_columns(self.series.__dict__)
         if bare and self.bare is not None:
-            extra = {k: v for k, v in self.bare.__dict__.items() if k in FLOOR_CHANNELS}
-            for name, column in frame_columns(extra, "bare_").items():
-                frame[name] = column
-        return frame
+            floors = {k: v for k, v in self.bare.__dict__.items() if k in FLOOR_CHANNELS}
+            columns.update(frame_columns(floors, "bare_"))
+        return _frame(self.t, columns)
 
     def __repr__(self) -> str:
         s = self.summary
