@@ -23,7 +23,7 @@ Inside sim_host/, the rooms (sim_host/README.md), each including only its own
 files and the rooms below it; no source file outside a room, no room of more
 than 20 source files:
   io < scene < engines < run < reference < studies < bench, hil (hil/, hil/link/,
-  hil/modes/: one bench) < python < cli
+  hil/modes/: one bench) < python, monitor (the page, on hil) < cli
 
 No contact law is named outside its registry (firmware/include/vines/
 contact_laws.hpp; params.hpp holds the codes): the product's code (firmware/,
@@ -67,7 +67,8 @@ HOST_ROOMS = {"io": [], "scene": _BELOW[:1], "engines": _BELOW[:2], "run": _BELO
 HOST_ROOMS.update({room: _BELOW + _HIL for room in _HIL})
 HOST_ROOMS["bench"] = _BELOW + ["studies"]
 HOST_ROOMS["python"] = _BELOW + _HIL + ["studies"]
-HOST_ROOMS["cli"] = _BELOW + _HIL + ["studies", "bench", "python"]
+HOST_ROOMS["monitor"] = _BELOW + _HIL
+HOST_ROOMS["cli"] = _BELOW + _HIL + ["studies", "bench", "python", "monitor"]
 ROOM_MAX_FILES = 20
 SOURCE = (".hpp", ".h", ".cpp", ".c", ".in")
 

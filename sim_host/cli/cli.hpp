@@ -75,6 +75,7 @@ void add_stress(CLI::App& vines);
 void add_hil(CLI::App& vines);
 void add_image(CLI::App& vines);
 void add_node(CLI::App& vines);
+void add_view(CLI::App& vines);
 void add_help(CLI::App& vines);  // `vines help [COMMAND]` (help.cpp)
 
 }  // namespace vines::cli

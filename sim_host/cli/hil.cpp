@@ -1,5 +1,6 @@
 // `vines hil SCENE.toml`: the hardware-in-the-loop bench around `vines node`.
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <iterator>
@@ -12,6 +13,7 @@
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/cli/hil_print.hpp"
+#include "sim_host/cli/serve.hpp"
 #include "sim_host/hil/hil.hpp"
 #include "sim_host/scene/scene.hpp"
 
@@ -23,6 +25,7 @@ struct HilArgs {
   host::HilOptions opt;
   bool as_json = false;
   bool accept_degraded = false;
+  std::string serve;              // --serve ("" : no page)
   const CLI::App* cmd = nullptr;  // for the options given (check_options)
 };
 
@@ -50,7 +53,15 @@ void check_options(const HilArgs& a) {
 int hil(const HilArgs& a) {
   check_options(a);
   const host::Scene scene = host::load_scene(a.scene_path);
-  const host::HilReport r = host::run_hil(scene, a.opt);
+  // The page (--serve) listens before the bench starts; after the run its
+  // clients get up to 2 s to read the report.
+  std::unique_ptr<ServedPage> page;
+  if (!a.serve.empty()) {
+    page = std::make_unique<ServedPage>();
+    page->listen("vines hil", a.serve);
+  }
+  const host::HilReport r = host::run_hil(scene, a.opt, page ? page->watch() : nullptr);
+  if (page) page->stop(std::chrono::milliseconds(2000));
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
   else print_hil(r);
   if (!r.outputs_finite) return kRefused;
@@ -118,6 +129,9 @@ void add_hil(CLI::App& vines) {
       ->type_name("S")
       ->check(number_in(1e-6, 1e6));
   cmd->add_flag("--json", a->as_json, "print one JSON object");
+  add_serve(*cmd, &a->serve,
+            "serve the monitoring page while the bench runs (127.0.0.1 unless HOST is given; 0: any free port; "
+            "read-only, at most 4 clients; sim_host/monitor/README.md)");
   add_accept_degraded(*cmd, &a->accept_degraded);
   cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
   cmd->add_option("--timeout", opt.timeout_s, "longest wait for the node (default 5, 60 with QEMU)")

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   add_hil(vines);
   add_image(vines);
   add_node(vines);
+  add_view(vines);
   add_help(vines);
   try {
     vines.parse(argc, argv);

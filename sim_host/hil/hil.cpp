@@ -15,7 +15,7 @@
 
 namespace vines::host {
 
-HilReport run_hil(const Scene& scene, const HilOptions& opt) {
+HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch) {
   // The options checked against the scene; the node, the record, the node's
   // configuration and model image.
   const Bench b = make_bench(scene, opt);
@@ -33,7 +33,8 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
   std::vector<FaultEvent> events = plan_faults(b.opt, b.samples);
   // The run; what a node that restarted should have given: the clean run of
   // each of its lives, from rest at its restart (the offline run if none).
-  const HilRecord rec = stream(b, *mode, &events);
+  if (watch) watch->start(b);
+  const HilRecord rec = stream(b, *mode, &events, watch);
   std::vector<long long> restarts;
   for (const FaultEvent& e : events)
     if (e.kind == FaultKind::kRestart) restarts.push_back(e.k);
@@ -45,6 +46,7 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt) {
   mode->report(rec, offline, &report);
   if (!b.opt.csv.empty())
     write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec));
+  if (watch) watch->finish(report);
   return report;
 }
 

@@ -13,6 +13,7 @@
 #include "sim_host/hil/link/boards.hpp"
 #include "sim_host/hil/options.hpp"
 #include "sim_host/hil/report.hpp"
+#include "sim_host/hil/watch.hpp"
 #include "sim_host/scene/scene.hpp"
 
 namespace vines::host {
@@ -20,8 +21,8 @@ namespace vines::host {
 
 // Runs the bench; returns the report (to_json in hil_report.hpp). Throws
 // std::runtime_error naming the input (scene, option, node) on any error the
-// user can cause.
-HilReport run_hil(const Scene& scene, const HilOptions& opt);
+// user can cause. A watch (none by default) sees the run as it happens.
+HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch = nullptr);
 
 // `vines node`: the host firmware node on stdin/stdout, deadlines on the local
 // clock with realtime; it gives up after idle_timeout_s without a byte.

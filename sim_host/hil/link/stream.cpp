@@ -17,8 +17,8 @@ using link::Telemetry;
 
 class Stream {
  public:
-  Stream(const Bench& b, BenchMode& mode, std::vector<FaultEvent>* events)
-      : b_(b), o_(b.opt), mode_(mode), K_(b.samples), rec_(b.samples, b.opt.mode == HilMode::kHybrid),
+  Stream(const Bench& b, BenchMode& mode, std::vector<FaultEvent>* events, HilWatch* watch)
+      : b_(b), o_(b.opt), mode_(mode), watch_(watch), K_(b.samples), rec_(b.samples, b.opt.mode == HilMode::kHybrid),
         at_(static_cast<std::size_t>(b.samples), nullptr), rng_(b.opt.seed + 5) {
     for (FaultEvent& e : *events) at_[static_cast<std::size_t>(e.k)] = &e;
     // The samples as the sensor gives them (clipped at its range).
@@ -61,6 +61,7 @@ class Stream {
       rec_.arrival[t.k] = now;
       rec_.tel_life[t.k] = life;
       mode_.on_telemetry(t);
+      if (watch_) watch_->step(t.k, rec_);
     };
     return n;
   }
@@ -166,6 +167,7 @@ class Stream {
   const Bench& b_;
   const HilOptions& o_;
   BenchMode& mode_;
+  HilWatch* watch_;  // none: nobody watches
   const long long K_;
   HilRecord rec_;
   std::vector<FaultEvent*> at_;  // the fault planned at each sample
@@ -179,8 +181,8 @@ class Stream {
 
 }  // namespace
 
-HilRecord stream(const Bench& b, BenchMode& mode, std::vector<FaultEvent>* events) {
-  return Stream(b, mode, events).run();
+HilRecord stream(const Bench& b, BenchMode& mode, std::vector<FaultEvent>* events, HilWatch* watch) {
+  return Stream(b, mode, events, watch).run();
 }
 
 }  // namespace vines::host

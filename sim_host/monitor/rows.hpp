@@ -1,0 +1,71 @@
+// The page's series for a run: names (those of the run's --csv columns, so
+// that `vines view` and the browser test read them back by name), units and
+// the chart each is drawn in; and, for a bench run, their values sample by
+// sample from the record.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sim_host/hil/bench.hpp"
+#include "sim_host/hil/record.hpp"
+
+namespace vines::host::monitor {
+
+struct Series {
+  std::string name;   // the --csv column
+  std::string label;  // as the page shows it
+  std::string unit;
+  std::string panel;  // the chart: ground, floors, device, contact, stiffness, health, alarm, table, force, tracking, flags
+};
+
+// What the page is told first: the run and its series.
+struct PageMeta {
+  std::string source;  // the scene (live) or the CSV (view)
+  std::string mode;    // replay, twin, hybrid
+  bool live = true;
+  double rate_hz = 0;  // sensor rate
+  int every = 1;       // the page gets every this many samples
+  int stories = 0;
+  std::vector<Series> series;
+};
+nlohmann::json to_json(const PageMeta& m);
+
+// A series by its --csv column's name, in a mode (replay, twin, hybrid) with
+// a device: its label, unit and panel.
+Series describe(const std::string& name, const std::string& mode, DeviceKind device);
+
+// Every how many samples the page gets one: about 200 a second of record.
+int page_every(double rate_hz);
+
+// The tracking error's running RMS in % of the target's (hybrid: the table
+// against the frame's top floor, as the report's tracking_rms_pct at the end).
+class RunningTracking {
+ public:
+  void add(double target, double measured) { se_ += (measured - target) * (measured - target), sr_ += target * target; }
+  double pct() const;
+
+ private:
+  double se_ = 0, sr_ = 0;
+};
+
+// A bench run's series and their values from the record.
+class BenchRows {
+ public:
+  explicit BenchRows(const Bench& b);
+  const PageMeta& meta() const { return meta_; }
+  // Sample k's telemetry came: what is held across samples is updated (the
+  // twin's factors, one a step; the tracking RMS), and its row put in *v.
+  void take(long long k, const HilRecord& rec, std::vector<double>* v);
+
+ private:
+  const Bench& b_;
+  PageMeta meta_;
+  int params_ = 0;                  // twin estimator: the factors (stories, then the device's)
+  std::vector<double> eta_, sd_;    // each held from its last telemetry
+  RunningTracking tracking_;
+};
+
+}  // namespace vines::host::monitor

@@ -1,0 +1,44 @@
+// The page's HTTP server, on cpp-httplib (its own threads): GET of the page's
+// files and of /events, the hub's events as Server-Sent Events; any other
+// method refused (405): nothing on the page can change the run.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "sim_host/monitor/hub.hpp"
+
+namespace vines::host::monitor {
+
+// Where to listen: --serve [HOST:]PORT (HOST 127.0.0.1 unless given).
+struct Address {
+  std::string host = "127.0.0.1";
+  int port = 0;  // 0: any free port
+};
+// Parses [HOST:]PORT; throws std::invalid_argument naming OPTION and VALUE.
+Address parse_address(const std::string& option, const std::string& value);
+
+class PageServer {
+ public:
+  // Listens at once (the port known when this returns) and serves on its
+  // own threads; throws std::runtime_error naming the address if it cannot.
+  PageServer(Hub& hub, const Address& at);
+  ~PageServer();  // stop(0)
+  PageServer(const PageServer&) = delete;
+  PageServer& operator=(const PageServer&) = delete;
+
+  int port() const { return port_; }
+  std::string url() const;
+  // Gives the clients up to `linger` to read the hub's last events (close it
+  // first), then stops.
+  void stop(std::chrono::milliseconds linger);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string host_;
+  int port_ = 0;
+};
+
+}  // namespace vines::host::monitor

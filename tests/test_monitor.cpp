@@ -1,0 +1,328 @@
+// The monitoring page's parts (sim_host/monitor/): the decimator keeps the
+// run's own numbers; the hub gives every client every event in order, bounds
+// its clients and its history, and drops a client that falls behind; the
+// server (cpp-httplib) serves the page read-only, refuses a port in use, and
+// drops a client that stops reading while the bench publishes on undisturbed;
+// `vines view` reads a run's --csv back into the same frames.
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include "sim_host/monitor/decimator.hpp"
+#include "sim_host/monitor/hub.hpp"
+#include "sim_host/monitor/rows.hpp"
+#include "sim_host/monitor/server.hpp"
+#include "sim_host/monitor/view.hpp"
+
+namespace vines::host::monitor {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+// An event's name and its data as JSON.
+std::pair<std::string, nlohmann::json> parse_event(const std::string& e) {
+  const std::size_t nl = e.find('\n');
+  EXPECT_EQ(e.rfind("event: ", 0), 0u) << e;
+  EXPECT_EQ(e.substr(e.size() - 2), "\n\n");
+  const std::string data = e.substr(nl + 1, e.size() - nl - 3);
+  EXPECT_EQ(data.rfind("data: ", 0), 0u) << e;
+  return {e.substr(7, nl - 7), nlohmann::json::parse(data.substr(6))};
+}
+
+// Every 5th sample in, 3 to a frame; the values as they were, bit for bit
+// (shortest round trip), NaN as null; a sample again (after a restart) or
+// older than the last kept is not sent twice.
+TEST(Decimator, KeepsEveryMthSampleExactly) {
+  Decimator d(5, 3, 2);
+  std::vector<std::string> events;
+  std::string e;
+  const double third = 1.0 / 3.0;
+  for (long long k = 0; k < 40; ++k) {
+    if (!d.keeps(k)) continue;
+    const double v = k == 20 ? std::numeric_limits<double>::quiet_NaN() : third * static_cast<double>(k);
+    if (d.add(k, {v, -static_cast<double>(k)}, &e)) events.push_back(e);
+  }
+  EXPECT_FALSE(d.keeps(35));  // kept already
+  EXPECT_FALSE(d.keeps(30));
+  EXPECT_TRUE(d.flush(&e));
+  events.push_back(e);
+  EXPECT_FALSE(d.flush(&e));
+  ASSERT_EQ(events.size(), 3u);  // 8 samples kept: 3 + 3 + 2
+  std::vector<long long> ks;
+  for (const std::string& ev : events) {
+    const auto [name, j] = parse_event(ev);
+    EXPECT_EQ(name, "frame");
+    for (std::size_t i = 0; i < j["k"].size(); ++i) {
+      const long long k = j["k"][i];
+      ks.push_back(k);
+      if (k == 20) EXPECT_TRUE(j["v"][0][i].is_null());
+      else EXPECT_EQ(j["v"][0][i].get<double>(), third * static_cast<double>(k));  // bit for bit
+      EXPECT_EQ(j["v"][1][i].get<double>(), -static_cast<double>(k));
+    }
+  }
+  EXPECT_EQ(ks, (std::vector<long long>{0, 5, 10, 15, 20, 25, 30, 35}));
+  std::string unused;
+  EXPECT_THROW(d.add(40, {1.0}, &unused), std::invalid_argument);
+  EXPECT_THROW(Decimator(0, 1, 1), std::invalid_argument);
+}
+
+TEST(Decimator, AboutTwoHundredPointsASecond) {
+  EXPECT_EQ(page_every(1000), 5);
+  EXPECT_EQ(page_every(2048), 10);
+  EXPECT_EQ(page_every(50), 1);
+}
+
+// Reads a client's events until the end (or behind); their texts.
+std::vector<std::string> read_all(Hub& hub, long long cursor, Hub::Next* last) {
+  std::vector<std::string> got;
+  std::vector<Event> ev;
+  for (;;) {
+    const Hub::Next n = hub.next(&cursor, &ev, 2000ms);
+    for (const Event& e : ev) got.push_back(*e);
+    if (n == Hub::Next::kEnd || n == Hub::Next::kBehind || n == Hub::Next::kIdle) {
+      *last = n;
+      return got;
+    }
+  }
+}
+
+// A client that joined before anything (and one after the run) gets the
+// header first, then every event in order, then the end.
+TEST(Hub, EveryClientGetsTheHeaderThenEveryEventInOrder) {
+  Hub hub;
+  const std::optional<long long> early = hub.join();
+  ASSERT_TRUE(early);
+  std::vector<std::string> got_early;
+  Hub::Next last_early{};
+  std::thread reader([&] { got_early = read_all(hub, *early, &last_early); });
+  hub.set_header("H");
+  for (int i = 0; i < 5000; ++i) hub.publish("e" + std::to_string(i));
+  hub.close();
+  reader.join();
+  const std::optional<long long> late = hub.join();
+  ASSERT_TRUE(late);
+  Hub::Next last_late{};
+  std::vector<std::string> got_late = read_all(hub, *late, &last_late);
+  for (const std::vector<std::string>* got : {&got_early, &got_late}) {
+    ASSERT_EQ(got->size(), 5001u);
+    EXPECT_EQ((*got)[0], "H");
+    for (int i = 0; i < 5000; ++i) ASSERT_EQ((*got)[static_cast<std::size_t>(i) + 1], "e" + std::to_string(i));
+  }
+  EXPECT_EQ(last_early, Hub::Next::kEnd);
+  EXPECT_EQ(last_late, Hub::Next::kEnd);
+  EXPECT_EQ(hub.published(), 5000);
+}
+
+// At most max_clients at once; one leaving frees its place.
+TEST(Hub, BoundsItsClients) {
+  Hub hub(HubLimits{2, 1 << 20});
+  EXPECT_TRUE(hub.join());
+  EXPECT_TRUE(hub.join());
+  EXPECT_FALSE(hub.join());
+  hub.leave();
+  EXPECT_TRUE(hub.join());
+  EXPECT_EQ(hub.clients(), 2);
+}
+
+// A client that does not read falls out of the bounded history and is told
+// so (its server drops it); the bench publishes on, and a client that joins
+// later gets the newest history.
+TEST(Hub, AClientThatFallsOutOfTheHistoryIsBehind) {
+  Hub hub(HubLimits{4, 1000});
+  hub.set_header("H");
+  const std::optional<long long> idle = hub.join();
+  for (int i = 0; i < 1000; ++i) hub.publish(std::string(100, 'x'));  // 100 kB through a 1 kB history
+  long long c = *idle;
+  std::vector<Event> ev;
+  EXPECT_EQ(hub.next(&c, &ev, 0ms), Hub::Next::kBehind);  // the header, then behind
+  EXPECT_EQ(ev.size(), 1u);
+  const std::optional<long long> fresh = hub.join();
+  hub.close();
+  Hub::Next last{};
+  EXPECT_EQ(read_all(hub, *fresh, &last).size(), 1u + 10u);  // the header and the 10 newest
+  EXPECT_EQ(last, Hub::Next::kEnd);
+}
+
+TEST(Server, ParsesHostAndPortAndNamesABadOne) {
+  EXPECT_EQ(parse_address("--serve", "8080").host, "127.0.0.1");
+  EXPECT_EQ(parse_address("--serve", "8080").port, 8080);
+  const Address a = parse_address("--serve", "0.0.0.0:0");
+  EXPECT_EQ(a.host, "0.0.0.0");
+  EXPECT_EQ(a.port, 0);
+  for (const char* bad : {"", "abc", "70000", "-1", ":80", "localhost:", "8080x", "123456"}) {
+    try {
+      parse_address("--serve", bad);
+      ADD_FAILURE() << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("--serve ") + bad), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The page's files, GET only; /events gives the hub's events; a second
+// server on the same port is refused, naming it.
+TEST(Server, ServesThePageReadOnlyAndRefusesAPortInUse) {
+  Hub hub;
+  PageServer server(hub, Address{"127.0.0.1", 0});
+  ASSERT_GT(server.port(), 0);
+  httplib::Client cli("127.0.0.1", server.port());
+  auto r = cli.Get("/");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_NE(r->body.find("/app.js"), std::string::npos);
+  EXPECT_EQ(r->get_header_value("Content-Type"), "text/html; charset=utf-8");
+  for (const char* f : {"/app.js", "/uPlot.iife.min.js", "/uPlot.min.css"}) {
+    auto g = cli.Get(f);
+    ASSERT_TRUE(g) << f;
+    EXPECT_EQ(g->status, 200) << f;
+    EXPECT_GT(g->body.size(), 1000u) << f;
+  }
+  EXPECT_EQ(cli.Get("/nothing")->status, 404);
+  EXPECT_EQ(cli.Post("/events", "x", "text/plain")->status, 405);
+  EXPECT_EQ(cli.Put("/", "x", "text/plain")->status, 405);
+  EXPECT_EQ(cli.Delete("/")->status, 405);
+  hub.set_header("event: meta\ndata: {}\n\n");
+  hub.publish("event: frame\ndata: {\"k\":[0]}\n\n");
+  hub.close();
+  auto ev = cli.Get("/events");
+  ASSERT_TRUE(ev);
+  EXPECT_EQ(ev->get_header_value("Content-Type"), "text/event-stream");
+  EXPECT_EQ(ev->body, "event: meta\ndata: {}\n\nevent: frame\ndata: {\"k\":[0]}\n\n");
+  try {
+    PageServer again(hub, Address{"127.0.0.1", server.port()});
+    ADD_FAILURE() << "a port in use";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("--serve 127.0.0.1:" + std::to_string(server.port())), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(PageServer(hub, Address{"203.0.113.7", 0}), std::runtime_error);  // not this machine's
+}
+
+// A client that asks for /events and never reads: its socket fills, its
+// write times out and it is dropped, while the bench publishes 40 MB on
+// without waiting and a reading client gets every event.
+TEST(Server, DropsAClientThatStopsReadingWithoutStallingTheBench) {
+  Hub hub;
+  PageServer server(hub, Address{"127.0.0.1", 0});
+  hub.set_header("event: meta\ndata: {}\n\n");
+  // The client that stops reading: a raw socket, its receive buffer small.
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  const int small = 4096;
+  ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(server.port()));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::string get = "GET /events HTTP/1.1\r\nHost: x\r\n\r\n";
+  ASSERT_EQ(::send(s, get.data(), get.size(), 0), static_cast<ssize_t>(get.size()));
+  // The reading client.
+  std::atomic<std::size_t> read_bytes{0};
+  std::thread reader([&] {
+    httplib::Client cli("127.0.0.1", server.port());
+    cli.set_read_timeout(30, 0);
+    cli.Get("/events", [&](const char*, std::size_t n) {
+      read_bytes += n;
+      return true;
+    });
+  });
+  while (hub.clients() < 2) std::this_thread::sleep_for(1ms);
+  const std::string event = "event: frame\ndata: " + std::string(10000, 'x') + "\n\n";
+  double worst_publish_s = 0;
+  const auto t0 = Clock::now();
+  for (int i = 0; i < 4000; ++i) {
+    const auto a = Clock::now();
+    hub.publish(event);
+    worst_publish_s = std::max(worst_publish_s, std::chrono::duration<double>(Clock::now() - a).count());
+    if (i % 100 == 0) std::this_thread::sleep_for(5ms);  // a bench's pace: 2 MB/s
+  }
+  const double publish_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  for (int i = 0; i < 500 && hub.dropped() == 0; ++i) std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(hub.dropped(), 1);
+  hub.close();
+  reader.join();
+  ::close(s);
+  const std::size_t header = std::string("event: meta\ndata: {}\n\n").size();
+  EXPECT_EQ(read_bytes.load(), header + 4000 * event.size());
+  EXPECT_LT(worst_publish_s, 0.05) << "a publish waited";
+  EXPECT_LT(publish_s, 10.0);
+  server.stop(1000ms);
+}
+
+// `vines view`: a run's CSV back into the page's frames, the same series and
+// samples as live (every 5th at 1 kHz, received only), the hybrid tracking
+// RMS computed as the bench does; a bad cell named with its row and column.
+TEST(View, ReadsARunsCsvIntoTheSameFrames) {
+  const auto dir = std::filesystem::temp_directory_path() / "vines_test_view";
+  std::filesystem::create_directories(dir);
+  const auto csv = dir / "hybrid.csv";
+  {
+    std::ofstream f(csv);
+    f << "k,t_s,ag_sent_mps2,ag_used_mps2,received,flags,latency_us,x_top_m,x_top_offline_m,deviation_m,"
+         "acc_top_mps2,Ee_Js,particle_x_m,contact_force_n,dissipated_J,aux,drift_alarms,table_x_m,force_measured_n\n";
+    for (int k = 0; k < 50; ++k)
+      f << k << "," << k * 0.001 << "," << 0.1 * k << ",0," << (k == 10 ? 0 : 1) << ",0,0," << 0.01 * k
+        << ",0,0,0,0,0,0,0," << 0.02 * k << ",0," << 0.011 * k << "," << 3 * k << "\n";
+  }
+  Hub hub;
+  load_run(dir.string(), &hub);  // the folder's only .csv
+  const std::optional<long long> c = hub.join();
+  Hub::Next last{};
+  const std::vector<std::string> events = read_all(hub, *c, &last);
+  const auto [name, meta] = parse_event(events.at(0));
+  EXPECT_EQ(name, "meta");
+  EXPECT_EQ(meta["mode"], "hybrid");
+  EXPECT_EQ(meta["every"], 5);
+  std::vector<std::string> series;
+  for (const auto& s : meta["series"]) series.push_back(s["name"]);
+  EXPECT_EQ(series, (std::vector<std::string>{"ag_sent_mps2", "x_top_m", "flags", "table_x_m", "aux",
+                                              "force_measured_n", "tracking_rms_pct"}));
+  std::vector<long long> ks;
+  std::vector<double> ag, tracking;
+  for (std::size_t i = 1; i + 1 < events.size(); ++i) {
+    const auto [n, j] = parse_event(events[i]);
+    for (std::size_t p = 0; p < j["k"].size(); ++p) {
+      ks.push_back(j["k"][p]);
+      ag.push_back(j["v"][0][p]);
+      tracking.push_back(j["v"][6][p]);
+    }
+  }
+  EXPECT_EQ(parse_event(events.back()).first, "end");
+  EXPECT_EQ(ks, (std::vector<long long>{0, 5, 15, 20, 25, 30, 35, 40, 45}));  // 10 not received
+  EXPECT_EQ(ag[1], 0.1 * 5);
+  // The table 10 % above the top floor throughout: 10 % RMS.
+  EXPECT_NEAR(tracking.back(), 10.0, 1e-9);
+  {
+    std::ofstream f(dir / "hybrid.csv", std::ios::app);
+    f << "50,0.05,oops,0,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n";
+  }
+  Hub other;
+  try {
+    load_run(csv.string(), &other);
+    ADD_FAILURE();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("row 52, column ag_sent_mps2: 'oops'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_run((dir / "none.csv").string(), &other), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vines::host::monitor
