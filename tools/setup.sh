@@ -19,6 +19,7 @@ build=(
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
   libcli11-dev                                   # the vines command line
   libtbb-dev                                     # the parallel map of sweep, design, stress
+  libcpp-httplib-dev pkg-config                  # the monitoring page (vines hil --serve, view)
 )
 plots=(
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
@@ -35,6 +36,7 @@ rest=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
   qemu-system-arm                                # runs the MCU images (ctest)
+  chromium                                       # the monitoring page's browser test
 )
 
 if (($# > 1)); then
@@ -53,6 +55,13 @@ case $set_name in
     exit 2
     ;;
 esac
+
+# Node.js and npm for the browser test (puppeteer-core), Debian's unless a
+# node with npm is there already (NodeSource's nodejs holds npm and
+# conflicts with Debian's npm package).
+if [[ $set_name == all ]] && ! { command -v node && command -v npm; } >/dev/null; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,159 @@
+// The monitoring page in a real browser (sim_host/monitor/README.md): Debian's
+// headless chromium, driven over the DevTools protocol by puppeteer-core,
+// loads the page of `vines hil --serve` during a digital-twin run against a
+// damaged truth (story 3 at 90 %), and then `vines view` of the run's --csv.
+// Checks: the page was live (data before the run ended); the values it
+// plotted are the run's (read back from the page, against the --csv, bit for
+// bit where the CSV is exact); every kept sample is there; the alarm names
+// story 3 when the report does, at the sample it came; the replay equals the
+// live page. Saves a screenshot.
+//
+//   node page_test.js VINES SOURCE_DIR OUT_DIR
+"use strict";
+
+const { spawn } = require("child_process");
+const fs = require("fs");
+const path = require("path");
+const puppeteer = require("puppeteer-core");
+
+const [vines, source, out] = process.argv.slice(2);
+const chromium = process.env.VINES_CHROMIUM || "/usr/bin/chromium";
+fs.mkdirSync(out, { recursive: true });
+
+function fail(msg) {
+  console.error("FAIL: " + msg);
+  process.exitCode = 1;
+}
+function check(ok, msg) {
+  if (!ok) fail(msg);
+  return ok;
+}
+
+// A vines command; resolves with its page's URL (from "... the page is at URL").
+function start(args) {
+  const p = spawn(vines, args, { cwd: source });
+  p.stdoutText = "";
+  p.stderrText = "";
+  p.stdout.on("data", (d) => (p.stdoutText += d));
+  p.exited = new Promise((res) => p.on("exit", (code, signal) => res({ code, signal })));
+  p.url = new Promise((res, rej) => {
+    p.stderr.on("data", (d) => {
+      p.stderrText += d;
+      const m = /the page is at (http:\/\/\S+)/.exec(p.stderrText);
+      if (m) res(m[1]);
+    });
+    p.exited.then((e) => rej(new Error(`vines ${args[0]} exited (${e.code}) before serving: ${p.stderrText}`)));
+  });
+  return p;
+}
+
+// The --csv as columns by name.
+function readCsv(file) {
+  const lines = fs.readFileSync(file, "utf8").trim().split("\n");
+  const names = lines[0].split(",");
+  const cols = {};
+  names.forEach((n) => (cols[n] = []));
+  for (const line of lines.slice(1)) line.split(",").forEach((c, j) => cols[names[j]].push(Number(c)));
+  return cols;
+}
+
+// What the page holds (window.vinesPage, sim_host/monitor/page/app.js).
+const pageData = (page) =>
+  page.evaluate(() => {
+    const p = window.vinesPage;
+    return { meta: p.meta, k: p.k, data: p.data, alarms: p.alarms, report: p.report, ended: p.ended,
+             banner: document.getElementById("alarm").textContent };
+  });
+
+async function main() {
+  const csv = path.join(out, "twin.csv");
+  const run = start(["hil", "data/scenes/elcentro_vines.toml", "--mode", "twin", "--truth",
+    "data/scenes/twin/truth_story3_loss10.toml", "--sensors", "3,6,8,10", "--measure-noise-pct", "5",
+    "--realtime", "--grace", "100", "--duration", "10", "--serve", "0", "--csv", csv, "--json"]);
+  const url = await run.url;
+  const browser = await puppeteer.launch({ executablePath: chromium, headless: true,
+    args: ["--no-sandbox", "--disable-gpu", "--window-size=1280,1400"], defaultViewport: { width: 1240, height: 1300 } });
+  try {
+    const page = await browser.newPage();
+    const errors = [];
+    page.on("pageerror", (e) => errors.push(String(e)));
+    await page.goto(url);
+    // Live: samples on the page while the run goes on.
+    await page.waitForFunction(() => window.vinesPage.k.length > 200, { timeout: 60000 });
+    const during = await pageData(page);
+    check(!during.ended, "the page got its data only after the run ended");
+    await page.waitForFunction(() => window.vinesPage.ended, { timeout: 120000 });
+    await new Promise((r) => setTimeout(r, 300));  // a last redraw
+    const live = await pageData(page);
+    await page.screenshot({ path: path.join(out, "monitor_twin.png"), fullPage: true });
+    check(errors.length === 0, "page errors: " + errors.join("; "));
+    const exit = await run.exited;
+    check(exit.code === 0, `vines hil exit ${exit.code}: ${run.stderrText}`);
+    const report = JSON.parse(run.stdoutText);
+    const cols = readCsv(csv);
+
+    // Every kept sample (every 5th at 1 kHz, telemetry received) and only those.
+    const every = live.meta.every;
+    check(every === 5, `every ${every}`);
+    const kept = cols.k.filter((k, r) => k % every === 0 && cols.received[r] === 1);
+    check(JSON.stringify(live.k) === JSON.stringify(kept), `kept samples: page ${live.k.length}, CSV ${kept.length}`);
+    // The values: bit for bit where the CSV writes 17 digits, within its 9
+    // digits for the twin's own columns.
+    const exact = ["ag_sent_mps2", "x_top_m", "particle_x_m", "contact_force_n", "flags", "aux", "alarm_story"];
+    let compared = 0;
+    for (const s of live.meta.series) {
+      const tol = exact.includes(s.name) ? 0 : 1e-8;
+      const got = live.data[s.name], want = cols[s.name];
+      if (!check(want !== undefined, `series ${s.name} not in the CSV`)) continue;
+      let worst = 0;
+      live.k.forEach((k, i) => {
+        const d = Math.abs(got[i] - want[k]);
+        worst = Math.max(worst, tol === 0 ? d : d / Math.max(1, Math.abs(want[k])));
+      });
+      check(worst <= tol, `${s.name}: page against CSV off by ${worst} (allowed ${tol})`);
+      compared += got.length;
+    }
+    check(live.meta.series.length >= 25, `${live.meta.series.length} series (10 stories, device, bands)`);
+    // The alarm: the report's story, on the banner, from the sample it came.
+    const tw = report.twin;
+    check(tw.detected && tw.story === 3, `report: detected ${tw.detected}, story ${tw.story}`);
+    check(/damage: story 3/.test(live.banner), `banner "${live.banner}"`);
+    const first = live.alarms.find((a) => /story 3/.test(a.alarm));
+    if (check(first !== undefined, "no alarm in the page's history")) {
+      const firstCsv = cols.k.find((k, r) => cols.alarm_story[r] === 3 && k % every === 0);
+      check(first.k === firstCsv, `alarm on the page at k ${first.k}, in the CSV's kept samples at ${firstCsv}`);
+      check(Math.abs(first.t - tw.detect_time_s) <= every / 1000, `alarm at ${first.t} s, report ${tw.detect_time_s} s`);
+    }
+    check(live.report && live.report.twin.story === 3 && live.report.steps === report.steps, "the page's report");
+    console.log(`live: ${live.k.length} samples x ${live.meta.series.length} series (${compared} values) equal ` +
+      `to the CSV; alarm story 3 at ${first && first.t} s (report ${tw.detect_time_s} s); ` +
+      `deadline misses ${report.deadline_misses}, latency p99 ${report.latency_us.p99.toFixed(1)} us`);
+
+    // The replay of the run's --csv: the same page.
+    const view = start(["view", csv, "--serve", "0"]);
+    const page2 = await browser.newPage();
+    await page2.goto(await view.url);
+    await page2.waitForFunction(() => window.vinesPage.ended, { timeout: 60000 });
+    const replay = await pageData(page2);
+    check(JSON.stringify(replay.k) === JSON.stringify(live.k), "view: other samples than live");
+    for (const s of live.meta.series) {
+      const a = live.data[s.name], b = replay.data[s.name] || [];
+      const tol = exact.includes(s.name) ? 0 : 1e-8;
+      const worst = a.reduce((w, v, i) => Math.max(w, Math.abs(v - b[i]) / Math.max(1, Math.abs(v))), 0);
+      check(b.length === a.length && worst <= tol, `view: ${s.name} off the live page by ${worst}`);
+    }
+    check(/damage: story 3/.test(replay.banner), `view banner "${replay.banner}"`);
+    await page2.screenshot({ path: path.join(out, "monitor_view.png"), fullPage: true });
+    view.kill("SIGINT");
+    const vexit = await view.exited;
+    check(vexit.code === 0, `vines view exit ${vexit.code} ${vexit.signal} on Ctrl-C`);
+    console.log(`view: ${replay.k.length} samples equal to the live page; screenshots in ${out}`);
+  } finally {
+    await browser.close();
+    run.kill();
+  }
+}
+
+main().catch((e) => {
+  fail(e.stack || String(e));
+});
