@@ -112,6 +112,26 @@ expect 1 'more bytes)' -- "$VINES" run data/scenes/elcentro_vines.toml --record 
 if [ "$(wc -c < "$WORK/err")" -gt 2000 ]; then
   echo "FAIL: a 1 MB token printed whole ($(wc -c < "$WORK/err") bytes)"; failed=$((failed + 1))
 fi
+# The monitoring page (in a build with it): a bad address is a usage error,
+# a port in use, a host not this machine's, a missing run or a file that is
+# not a hil --csv are refused, each named.
+if "$VINES" help view > /dev/null 2>&1; then
+  expect 2 "--serve 80x: '80x' is not a port" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve 80x
+  expect 2 "--serve 70000" -- "$VINES" view "$WORK" --serve 70000
+  expect 2 "--serve :80: no host" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve :80
+  expect 1 "--serve 203.0.113.7:0: cannot listen there" -- "$VINES" hil data/scenes/elcentro_vines.toml \
+    --serve 203.0.113.7:0
+  expect 1 "$WORK/none.csv: no such file or folder" -- "$VINES" view "$WORK/none.csv"
+  expect 1 "not a \`vines hil --csv\` file (no column k)" -- "$VINES" view "$WORK/values.txt"
+  printf 'k,t_s,received,ag_sent_mps2,x_top_m\n0,0,1,0,0\n1,0.001,1,0,0\n' > "$WORK/run.csv"
+  "$VINES" view "$WORK/run.csv" --serve 0 --for 5 2> "$WORK/view_err" &
+  for _ in $(seq 50); do grep -q "page is at" "$WORK/view_err" && break; sleep 0.1; done
+  port=$(grep -o '127.0.0.1:[0-9]*' "$WORK/view_err" | cut -d: -f2)
+  expect 1 "--serve 127.0.0.1:$port: cannot listen there (Address already in use" -- \
+    "$VINES" view "$WORK/run.csv" --serve "$port"
+  wait
+fi
+
 # A file-size limit with SIGXFSZ at its default: a write error, exit 1.
 (ulimit -f 1; expect 1 "cannot write: File too large" -- "$VINES" run data/scenes/elcentro_vines.toml \
   --out "$WORK/xf"; exit "$failed") || failed=$((failed + 1))

@@ -130,10 +130,14 @@ void add_hil(CLI::App& vines) {
       ->check(number_in(1e-6, 1e6));
   cmd->add_flag("--json", a->as_json, "print one JSON object");
   add_serve(*cmd, &a->serve,
-            "serve the monitoring page while the bench runs (127.0.0.1 unless HOST is given; 0: any free port; "
-            "read-only, at most 4 clients; sim_host/monitor/README.md)");
+            "serve the monitoring page while the bench runs; ADDRESS: [HOST:]PORT (HOST 127.0.0.1 unless given; "
+            "PORT 0: any free one); read-only, at most 4 clients (docs/hil.md)");
   add_accept_degraded(*cmd, &a->accept_degraded);
   cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
+  add_number_list(*cmd, "--floors", &opt.floors, 1, 1000,
+                  "floors whose displacement --csv (x_F_m) and the page (--serve) add, 1-based, comma-separated "
+                  "(the top floor's is always there)")
+      ->type_name("F1,F2,...");
   cmd->add_option("--timeout", opt.timeout_s, "longest wait for the node (default 5, 60 with QEMU)")
       ->type_name("S")
       ->check(number_in(0.01, 3600));

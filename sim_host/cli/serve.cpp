@@ -26,7 +26,7 @@ CLI::Option* add_serve(CLI::App& cmd, std::string* at, const std::string& help) 
             *at = v;
           },
           help)
-      ->type_name("PORT|HOST:PORT");
+      ->type_name("ADDRESS");  // (the help cuts a type name at its first colon)
 }
 
 #ifdef VINES_HAVE_MONITOR

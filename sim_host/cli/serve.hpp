@@ -13,7 +13,7 @@
 
 namespace vines::cli {
 
-// Adds --serve [HOST:]PORT to a command, into *at ("" : not given); a value
+// Adds --serve ADDRESS ([HOST:]PORT) to a command, into *at ("" : not given); a value
 // that is not [HOST:]PORT is a usage error naming it.
 CLI::Option* add_serve(CLI::App& cmd, std::string* at, const std::string& help);
 

@@ -34,7 +34,7 @@ void add_view(CLI::App& vines) {
         return kOk;
       });
   cmd->add_option("RUN", a->run, "the run's --csv file, or a folder holding it (its only .csv)")->required();
-  add_serve(*cmd, &a->serve, "where the page is served (default 8037, on 127.0.0.1; 0: any free port)");
+  add_serve(*cmd, &a->serve, "where the page is served: [HOST:]PORT (default 8037, on 127.0.0.1; PORT 0: any free one)");
   cmd->add_option("--for", a->for_s, "serve S seconds, then exit (default: until Ctrl-C)")
       ->type_name("S")
       ->check(number_in(0, 1e7));

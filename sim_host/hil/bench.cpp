@@ -57,6 +57,14 @@ void check_mode_options(const HilOptions& o) {
   }
 }
 
+// --floors: floors of the scene's frame.
+void check_floors(const HilOptions& o, const Scene& sc) {
+  const int n = sc.params.frame.stories;
+  for (int f : o.floors)
+    if (f < 1 || f > n)
+      throw std::runtime_error("--floors " + std::to_string(f) + ": " + sc.path + " has floors 1 to " + std::to_string(n));
+}
+
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
 
 // The node: the host's `vines node` or a board in QEMU (its image, scalar and
@@ -119,6 +127,7 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   HilOptions& o = b.opt;
   const bool hybrid = o.mode == HilMode::kHybrid;
   check_mode_options(o);
+  check_floors(opt, scene);
   if (hybrid) check_specimen(sc);
   if (hybrid && o.comp_delay_s < 0)
     o.comp_delay_s = o.actuator_delay_s + 2 * o.actuator_zeta / (2 * M_PI * o.actuator_hz) + 0.5 * b.h;

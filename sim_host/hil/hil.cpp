@@ -45,7 +45,8 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch) {
   HilReport report = score(b, rec, offline, restarts.empty() ? offline : lives, &events);
   mode->report(rec, offline, &report);
   if (!b.opt.csv.empty())
-    write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec));
+    write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec),
+                  b.opt.floors);
   if (watch) watch->finish(report);
   return report;
 }

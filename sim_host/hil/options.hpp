@@ -48,6 +48,7 @@ struct HilOptions {
   bool realtime = false;
   double duration_s = 0;        // 0: the scene's
   std::string csv;              // "" : none
+  std::vector<int> floors;      // floors (1-based) whose displacement --csv and the page add
   double timeout_s = 0;         // longest wait for the node (0: 5 s, 60 s for a board in QEMU)
   double deadline_periods = 1;  // telemetry k due by (k + this) h
   unsigned long long seed = 1;

@@ -167,7 +167,7 @@ json to_json(const HilReport& r) {
 }
 
 void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h, const CsvColumns& extra) {
+                   int stories, double h, const CsvColumns& extra, const std::vector<int>& floors) {
   CsvWriter f(path);
   const bool hybrid = !rec.table_x.empty();
   const int n = stories;
@@ -178,6 +178,7 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
     f.raw(c);
   if (hybrid) f.raw("table_x_m").raw("force_measured_n");
   for (const std::string& c : extra.names) f.raw(c);
+  for (int fl : floors) f.raw("x_" + std::to_string(fl) + "_m");
   f.end_row();
   constexpr const char* kFull = "%.17g";
   for (long long k = 0; k < rec.samples; ++k) {
@@ -192,6 +193,7 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
     if (hybrid) f.number(rec.table_x[k], kFull).number(rec.force[k], kFull);
     if (!extra.names.empty())
       for (double v : extra.rows[static_cast<std::size_t>(k)]) f.number(v, "%.9g");
+    for (int fl : floors) f.number(t.x[fl - 1], kFull);
     f.end_row();
   }
   f.close();

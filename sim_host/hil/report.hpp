@@ -169,9 +169,10 @@ struct HilReport {
 // The report as `vines hil --json` prints it.
 nlohmann::json to_json(const HilReport& r);
 
-// Writes --csv: one row per sample (hybrid: with the table and the load cell).
-// Throws naming the file if it cannot be written.
+// Writes --csv: one row per sample (hybrid: with the table and the load cell;
+// then the mode's columns, then x_F_m of each of `floors`, 1-based). Throws
+// naming the file if it cannot be written.
 void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h, const CsvColumns& extra = {});
+                   int stories, double h, const CsvColumns& extra = {}, const std::vector<int>& floors = {});
 
 }  // namespace vines::host

@@ -34,10 +34,21 @@ Series describe(const std::string& name, const std::string& mode, DeviceKind dev
   if (name == "table_x_m") return {name, "table", "m", "floors"};
   if (name == "force_measured_n") return {name, "load cell", "N", "force"};
   if (name == "tracking_rms_pct") return {name, "tracking error RMS so far", "%", "tracking"};
+  if (name.size() > 4 && name.rfind("x_", 0) == 0 && name.substr(name.size() - 2) == "_m" &&
+      name.find_first_not_of("0123456789", 2) == name.size() - 2)
+    return {name, "floor " + name.substr(2, name.size() - 4), "m", "floors"};
   if (name.rfind("eta_sd_", 0) == 0) return {name, "sd", "", "band"};
   if (name == "eta_" + device_name) return {name, device_name, "", "health"};
   if (name.rfind("eta_", 0) == 0) return {name, "story " + name.substr(4), "", "stiffness"};
   return {name, name, "", "other"};
+}
+
+DeviceSeries device_series(const std::string& mode, DeviceKind device, bool estimator) {
+  DeviceSeries d;
+  d.particle = device != DeviceKind::kNone && (mode == "replay" || (mode == "twin" && !estimator));
+  d.contact = device == DeviceKind::kVines && mode != "hybrid";
+  d.truth_force = device == DeviceKind::kVines && mode == "twin";
+  return d;
 }
 
 BenchRows::BenchRows(const Bench& b) : b_(b) {
@@ -52,13 +63,14 @@ BenchRows::BenchRows(const Bench& b) : b_(b) {
   // then the mode's own (the order of take()). The twin's estimator has no
   // device model: it gives the device's force it estimates, not the sphere.
   const bool estimator = b.opt.mode == HilMode::kTwin && b.cfg.estimator == link::TwinEstimator::kKalman;
+  device_ = device_series(meta_.mode, dev, estimator);
   std::vector<std::string> names = {"ag_sent_mps2", "x_top_m"};
-  if (dev != DeviceKind::kNone && !estimator) names.push_back("particle_x_m");
-  if (dev == DeviceKind::kVines || (estimator && dev != DeviceKind::kNone)) names.push_back("contact_force_n");
+  if (device_.particle) names.push_back("particle_x_m");
+  if (device_.contact) names.push_back("contact_force_n");
   names.push_back("flags");
   if (b.opt.mode == HilMode::kTwin) {
     names.push_back("x_top_truth_m");
-    if (dev != DeviceKind::kNone) names.push_back("device_force_truth_n");
+    if (device_.truth_force) names.push_back("device_force_truth_n");
     names.push_back("aux");
     if (estimator) {
       // The stories' factors, then the device's, as the twin's --csv names them.
@@ -75,6 +87,8 @@ BenchRows::BenchRows(const Bench& b) : b_(b) {
   } else if (b.opt.mode == HilMode::kHybrid) {
     for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
   }
+  // The floors chosen (--floors), last.
+  for (int f : b.opt.floors) names.push_back("x_" + std::to_string(f) + "_m");
   for (const std::string& n : names) meta_.series.push_back(describe(n, meta_.mode, dev));
 }
 
@@ -86,14 +100,12 @@ void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) 
   v->clear();
   v->push_back(rec.sensed[i]);
   v->push_back(t.x[n - 1]);
-  const DeviceKind dev = b_.scene.params.device.kind;
-  const bool estimator = params_ > 0;
-  if (dev != DeviceKind::kNone && !estimator) v->push_back(t.particle_x);
-  if (dev == DeviceKind::kVines || (estimator && dev != DeviceKind::kNone)) v->push_back(t.contact_force);
+  if (device_.particle) v->push_back(t.particle_x);
+  if (device_.contact) v->push_back(t.contact_force);
   v->push_back(t.flags);
   if (b_.opt.mode == HilMode::kTwin) {
     v->push_back(b_.twin.truth.roof_x[i]);
-    if (dev != DeviceKind::kNone) v->push_back(b_.twin.truth.device_force[i]);
+    if (device_.truth_force) v->push_back(b_.twin.truth.device_force[i]);
     v->push_back(t.aux);
     if (params_ > 0) {
       v->insert(v->end(), eta_.begin(), eta_.end());
@@ -107,6 +119,7 @@ void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) 
     v->push_back(rec.force[i]);
     v->push_back(tracking_.pct());
   }
+  for (int f : b_.opt.floors) v->push_back(t.x[f - 1]);
 }
 
 }  // namespace vines::host::monitor

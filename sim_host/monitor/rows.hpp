@@ -37,6 +37,16 @@ nlohmann::json to_json(const PageMeta& m);
 // a device: its label, unit and panel.
 Series describe(const std::string& name, const std::string& mode, DeviceKind device);
 
+// Which of the device's series the node gives: the sphere or the TMD's mass
+// where the node runs the device's model (replay, the open-loop twin), the
+// contact force (VI NES: the model's, or the twin estimator's estimate of
+// the device's force on its floor), the truth's device force (twin, VI NES).
+// Hybrid: none (the device is on the table; the load cell reads it).
+struct DeviceSeries {
+  bool particle = false, contact = false, truth_force = false;
+};
+DeviceSeries device_series(const std::string& mode, DeviceKind device, bool estimator);
+
 // Every how many samples the page gets one: about 200 a second of record.
 int page_every(double rate_hz);
 
@@ -63,6 +73,7 @@ class BenchRows {
  private:
   const Bench& b_;
   PageMeta meta_;
+  DeviceSeries device_;
   int params_ = 0;                  // twin estimator: the factors (stories, then the device's)
   std::vector<double> eta_, sd_;    // each held from its last telemetry
   RunningTracking tracking_;

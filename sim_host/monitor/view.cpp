@@ -76,7 +76,7 @@ void load_run(const std::string& path, Hub* hub) {
   DeviceKind device = DeviceKind::kNone;
   if (col.count("eta_tmd")) device = DeviceKind::kTmd;
   else if (col.count("eta_device_floor_mass")) device = DeviceKind::kVines;
-  else
+  else if (col.count("contact_force_n") && col.count("particle_x_m"))
     for (std::size_t r = 0; r < rows.size() && device != DeviceKind::kVines; ++r) {
       if (at(r, "contact_force_n") != 0) device = DeviceKind::kVines;
       else if (at(r, "particle_x_m") != 0) device = DeviceKind::kTmd;
@@ -88,14 +88,14 @@ void load_run(const std::string& path, Hub* hub) {
   m.rate_hz = 1 / (at(1, "t_s") - at(0, "t_s"));
   m.every = page_every(m.rate_hz);
   // The series in the order the live page has them (rows.cpp).
-  const bool estimator = col.count("alarm_story") > 0;
+  const DeviceSeries ds = device_series(m.mode, device, col.count("alarm_story") > 0);
   std::vector<std::string> names = {"ag_sent_mps2", "x_top_m"};
-  if (device != DeviceKind::kNone && !estimator) names.push_back("particle_x_m");
-  if (device == DeviceKind::kVines || (estimator && device != DeviceKind::kNone)) names.push_back("contact_force_n");
+  if (ds.particle) names.push_back("particle_x_m");
+  if (ds.contact) names.push_back("contact_force_n");
   names.push_back("flags");
   if (twin) {
     names.push_back("x_top_truth_m");
-    if (device != DeviceKind::kNone) names.push_back("device_force_truth_n");
+    if (ds.truth_force) names.push_back("device_force_truth_n");
     names.push_back("aux");
     for (const std::string& h : header)
       if (h.rfind("eta_", 0) == 0 && h.rfind("eta_sd_", 0) != 0) names.push_back(h);
@@ -105,6 +105,15 @@ void load_run(const std::string& path, Hub* hub) {
   } else if (hybrid) {
     for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
   }
+  // The floors chosen (--floors), last: describe() knows them as floors.
+  for (const std::string& h : header)
+    if (describe(h, m.mode, device).panel == "floors" && h.rfind("x_", 0) == 0 && h != "x_top_m" &&
+        h != "x_top_offline_m" && h != "x_top_truth_m")
+      names.push_back(h);
+  // Those the file has (the tracking RMS: from the table and the top floor).
+  names.erase(std::remove_if(names.begin(), names.end(),
+                             [&](const std::string& n) { return n != "tracking_rms_pct" && !col.count(n); }),
+              names.end());
   for (const std::string& n : names) m.series.push_back(describe(n, m.mode, device));
   m.stories = 0;  // not in the CSV
   hub->set_header(sse_event("meta", to_json(m).dump()));

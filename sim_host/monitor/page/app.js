@@ -9,7 +9,7 @@ window.vinesPage = page;
 
 // The charts, one per panel, in this order; each its title.
 const PANELS = [
-  ["ground", "Ground acceleration"], ["floors", "Top floor"], ["device", "Device"],
+  ["ground", "Ground acceleration"], ["floors", "Floors"], ["device", "Device"],
   ["contact", "Contacts"], ["stiffness", "Story stiffness factors (band: 2 sd)"],
   ["health", "Device health"], ["residual", "Twin residual"], ["alarm", "Story in alarm"],
   ["force", "Load cell"], ["tracking", "Table tracking (vRTHS)"],
