@@ -6,7 +6,8 @@
 // plotted are the run's (read back from the page, against the --csv, bit for
 // bit where the CSV is exact); every kept sample is there; the alarm names
 // story 3 when the report does, at the sample it came; the replay equals the
-// live page. Saves a screenshot.
+// live page; in hybrid mode the table's tracking RMS is the report's.
+// Saves screenshots.
 //
 //   node page_test.js VINES SOURCE_DIR OUT_DIR
 "use strict";
@@ -148,10 +149,41 @@ async function main() {
     const vexit = await view.exited;
     check(vexit.code === 0, `vines view exit ${vexit.code} ${vexit.signal} on Ctrl-C`);
     console.log(`view: ${replay.k.length} samples equal to the live page; screenshots in ${out}`);
+    await hybrid(browser);
   } finally {
     await browser.close();
     run.kill();
   }
+}
+
+// Hybrid mode (the TMD on the table, 4 s in real time): the table, its
+// command and the load cell as the CSV has them, bit for bit; the tracking
+// RMS the page shows at the last sample equals the report's
+// tracking_rms_pct (computed apart, by rths_criteria.cpp).
+async function hybrid(browser) {
+  const csv = path.join(out, "hybrid.csv");
+  const run = start(["hil", "data/scenes/elcentro_tmd.toml", "--mode", "hybrid", "--realtime", "--grace", "100",
+    "--duration", "4", "--serve", "0", "--csv", csv, "--json"]);
+  const page = await browser.newPage();
+  await page.goto(await run.url);
+  await page.waitForFunction(() => window.vinesPage.ended, { timeout: 60000 });
+  const live = await pageData(page);
+  await page.screenshot({ path: path.join(out, "monitor_hybrid.png"), fullPage: true });
+  const exit = await run.exited;
+  check(exit.code === 0, `vines hil --mode hybrid exit ${exit.code}: ${run.stderrText}`);
+  const report = JSON.parse(run.stdoutText), cols = readCsv(csv);
+  for (const name of ["ag_sent_mps2", "x_top_m", "table_x_m", "aux", "force_measured_n"]) {
+    const got = live.data[name] || [];
+    const worst = live.k.reduce((w, k, i) => Math.max(w, Math.abs(got[i] - cols[name][k])), 0);
+    check(got.length === live.k.length && worst === 0, `hybrid ${name}: page against CSV off by ${worst}`);
+  }
+  const last = live.k[live.k.length - 1], shown = live.data.tracking_rms_pct[live.k.length - 1];
+  const want = report.hybrid.tracking_rms_pct;
+  check(last === report.samples - 1, `hybrid: last sample on the page ${last}, of ${report.samples}`);
+  check(Math.abs(shown - want) <= 1e-9 * want, `hybrid: tracking RMS on the page ${shown} %, report ${want} %`);
+  check(/tracking delay/.test(await page.$eval("#report", (e) => e.textContent)), "hybrid: the vRTHS criteria shown");
+  console.log(`hybrid: ${live.k.length} samples equal to the CSV; tracking RMS ${shown.toFixed(4)} % ` +
+    `(report ${want.toFixed(4)} %)`);
 }
 
 main().catch((e) => {
