@@ -102,6 +102,9 @@ bool HostPlant::configure(const link::NodeConfig& c, char* msg, std::size_t cap)
     return !why || refuse(why);
   }
   const Scalar scalar = scalar_of_code(c.scalar);
+  // The TMD's mass as the boards' nodes send it (link/model_plant.hpp): in
+  // double and float; the fixed-point node (fixed_plant.hpp) sends none.
+  tmd_mass_ = c.scene.device.kind == DeviceKind::kTmd && scalar != Scalar::kFixed;
   try {
     engine_ = engine_for(c.scene, scalar, "node");
   } catch (const EngineError& e) {
@@ -140,8 +143,8 @@ void HostPlant::read(link::Telemetry* t) {
   for (int i = 0; i < n; ++i) t->x[i] = s.x[i];
   t->acc_top = s.acc[n - 1];
   t->elastic_energy = s.elastic_energy;
-  t->particle_x = s.particle_x;
-  t->particle_v = s.particle_v;
+  t->particle_x = tmd_mass_ ? s.tmd_x : s.particle_x;
+  t->particle_v = tmd_mass_ ? s.tmd_v : s.particle_v;
   t->contact_force = s.contact_force;
   t->contact_mode = static_cast<std::uint8_t>(s.mode);
   t->dissipated = p.ledger.contact;

@@ -48,6 +48,7 @@ class HostPlant {
   link::HybridFrame<double> hybrid_;
   std::unique_ptr<link::TwinPlant<double, kMaxStories>> twin_;  // twin estimator (null otherwise)
   long long guard_events_ = 0;  // core guard counters at the last read
+  bool tmd_mass_ = false;       // telemetry's particle_x/v: the TMD's mass (double, float)
 };
 
 }  // namespace vines::host

@@ -72,6 +72,8 @@ struct Telemetry {
   double x[kMaxStories] = {};  // floor displacements [m], bottom first
   double acc_top = 0;    // predicted absolute top-floor acceleration [m/s^2]
   double elastic_energy = 0;   // E_e so far [J s]
+  // The device's mass, relative to the ground: the VI NES sphere (with its
+  // contact force on it) or, in double and float, the TMD's mass [m, m/s, N].
   double particle_x = 0, particle_v = 0, contact_force = 0;
   double dissipated = 0; // energy dissipated in contacts so far [J] (energy ledger on)
   double aux = 0;        // twin: measured - predicted top acceleration; hybrid: command sent [m]

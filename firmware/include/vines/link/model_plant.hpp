@@ -113,6 +113,11 @@ class ModelPlant {
       t->contact_force = static_cast<double>(d.contact_force);
       t->contact_mode = static_cast<std::uint8_t>(d.mode);
     }
+    if constexpr (Dev::kKind == DeviceKind::kTmd) {
+      // z = [x_1..x_N, x_d; v_1..v_N, v_d] (lti.hpp, DenseLti).
+      t->particle_x = static_cast<double>(d.z(N));
+      t->particle_v = static_cast<double>(d.z(2 * N + 1));
+    }
     t->dissipated = d.ledger.contact.wide();
     const std::int64_t guards = d.count.bad_samples + d.count.divergences;
     if (guards != guard_events_) t->flags |= kGuard;
