@@ -24,6 +24,9 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
+#include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/bench.hpp"
+#include "sim_host/hil/offline.hpp"
 #include "sim_host/monitor/decimator.hpp"
 #include "sim_host/monitor/hub.hpp"
 #include "sim_host/monitor/rows.hpp"
@@ -81,6 +84,22 @@ TEST(Decimator, KeepsEveryMthSampleExactly) {
   std::string unused;
   EXPECT_THROW(d.add(40, {1.0}, &unused), std::invalid_argument);
   EXPECT_THROW(Decimator(0, 1, 1), std::invalid_argument);
+}
+
+// Event samples (a VI NES contact) are kept off the grid too, each once.
+TEST(Decimator, KeepsEventSamplesOffTheGrid) {
+  Decimator d(5, 100, 1);
+  std::string event;
+  std::vector<long long> kept;
+  for (long long k = 0; k < 20; ++k) {
+    const bool contact = k >= 7 && k <= 11;
+    if (d.keeps(k, contact)) {
+      kept.push_back(k);
+      d.add(k, {static_cast<double>(k)}, &event);
+    }
+  }
+  EXPECT_EQ(kept, (std::vector<long long>{0, 5, 7, 8, 9, 10, 11, 15}));
+  EXPECT_FALSE(d.keeps(11, true));  // again (a restart, a late sample): not twice
 }
 
 TEST(Decimator, AboutTwoHundredPointsASecond) {
@@ -322,6 +341,52 @@ TEST(View, ReadsARunsCsvIntoTheSameFrames) {
   }
   EXPECT_THROW(load_run((dir / "none.csv").string(), &other), std::runtime_error);
   std::filesystem::remove_all(dir);
+}
+
+// The device's panel. The TMD's mass the page draws (the node's telemetry,
+// particle_x_m) is the TMD the engine steps, sample by sample (before, the
+// node sent 0); the page's meta names the floor it sits on, and for the VI
+// NES the box's free travel as the model designs it, (b/2 - R) with
+// b = beta 2R.
+TEST(Rows, TheDevicePanelIsTheDevice) {
+  const std::string scenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
+  HilOptions opt;
+  opt.duration_s = 5;
+  const Bench tmd = make_bench(load_scene(scenes + "elcentro_tmd.toml"), opt);
+  const std::vector<link::Telemetry> tel = offline_run(tmd.cfg, tmd.ex.samples, "tmd");
+  const std::unique_ptr<Engine> eng = build_engine(tmd.scene.params, tmd.scene.scalar, "tmd");
+  eng->init(tmd.ex.samples[0]);
+  double peak = 0;
+  for (std::size_t k = 0; k < tel.size(); ++k) {
+    if (k > 0) eng->step(tmd.ex.samples[k]);
+    const Snapshot s = eng->snapshot();
+    ASSERT_EQ(tel[k].particle_x, s.tmd_x) << "sample " << k;
+    ASSERT_EQ(tel[k].particle_v, s.tmd_v) << "sample " << k;
+    peak = std::max(peak, std::fabs(s.tmd_x));
+  }
+  EXPECT_GT(peak, 0.05);  // the TMD moved
+  const BenchRows tmd_rows(tmd);
+  EXPECT_EQ(tmd_rows.meta().device, "tmd");
+  EXPECT_EQ(tmd_rows.meta().device_floor_series, "x_top_m");
+  EXPECT_EQ(tmd_rows.meta().series.at(2).name, "particle_x_m");
+  // The fixed-point TMD node does not send its mass: not on the page.
+  Scene fixed = load_scene(scenes + "elcentro_tmd_fixed.toml");
+  const BenchRows fixed_rows(make_bench(fixed, opt));
+  for (const Series& x : fixed_rows.meta().series) EXPECT_NE(x.name, "particle_x_m");
+
+  const Scene vs = load_scene(scenes + "elcentro_vines.toml");
+  const BenchRows vines_rows(make_bench(vs, opt));
+  const VinesParams& v = vs.params.device.vines;
+  const double radius = build_engine(vs.params, vs.scalar, "vines")->info().vines.radius;
+  EXPECT_EQ(vines_rows.meta().device, "vines");
+  EXPECT_NEAR(vines_rows.meta().gap_m, (v.beta - 1) * radius, 1e-15);
+  EXPECT_GT(vines_rows.meta().gap_m, 0.0);
+  // Replay, twin (its estimator gives no sphere) and hybrid, as the --csv has them.
+  EXPECT_EQ(series_names("replay", device_series("replay", DeviceKind::kVines, false), {}, {"x_3_m"}),
+            (std::vector<std::string>{"ag_sent_mps2", "x_top_m", "particle_x_m", "contact_force_n", "flags", "x_3_m"}));
+  EXPECT_EQ(series_names("twin", device_series("twin", DeviceKind::kTmd, true), {"eta_1", "eta_tmd"}, {}),
+            (std::vector<std::string>{"ag_sent_mps2", "x_top_m", "flags", "x_top_truth_m", "aux", "eta_1", "eta_tmd",
+                                      "eta_sd_1", "eta_sd_tmd", "alarm_story"}));
 }
 
 }  // namespace

@@ -3,14 +3,22 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim_host/engines/build_engine.hpp"
+
 namespace vines::host::monitor {
 
 nlohmann::json to_json(const PageMeta& m) {
   nlohmann::json s = nlohmann::json::array();
   for (const Series& x : m.series)
     s.push_back({{"name", x.name}, {"label", x.label}, {"unit", x.unit}, {"panel", x.panel}});
-  return {{"source", m.source}, {"mode", m.mode}, {"live", m.live}, {"rate_hz", m.rate_hz},
-          {"every", m.every},   {"stories", m.stories}, {"series", s}};
+  return {{"source", m.source},
+          {"mode", m.mode},
+          {"live", m.live},
+          {"rate_hz", m.rate_hz},
+          {"every", m.every},
+          {"stories", m.stories},
+          {"device", {{"kind", m.device}, {"floor_series", m.device_floor_series}, {"gap_m", m.gap_m}}},
+          {"series", s}};
 }
 
 int page_every(double rate_hz) { return std::max(1, static_cast<int>(std::lround(rate_hz / 200))); }
@@ -43,13 +51,59 @@ Series describe(const std::string& name, const std::string& mode, DeviceKind dev
   return {name, name, "", "other"};
 }
 
-DeviceSeries device_series(const std::string& mode, DeviceKind device, bool estimator) {
+DeviceSeries device_series(const std::string& mode, DeviceKind device, bool estimator, bool fixed) {
   DeviceSeries d;
-  d.particle = device != DeviceKind::kNone && (mode == "replay" || (mode == "twin" && !estimator));
+  d.particle = device != DeviceKind::kNone && !(device == DeviceKind::kTmd && fixed) &&
+               (mode == "replay" || (mode == "twin" && !estimator));
   d.contact = device == DeviceKind::kVines && mode != "hybrid";
   d.truth_force = device == DeviceKind::kVines && mode == "twin";
   return d;
 }
+
+std::vector<std::string> series_names(const std::string& mode, const DeviceSeries& d,
+                                      const std::vector<std::string>& factors, const std::vector<std::string>& floors) {
+  std::vector<std::string> names = {"ag_sent_mps2", "x_top_m"};
+  if (d.particle) names.push_back("particle_x_m");
+  if (d.contact) names.push_back("contact_force_n");
+  names.push_back("flags");
+  if (mode == "twin") {
+    names.push_back("x_top_truth_m");
+    if (d.truth_force) names.push_back("device_force_truth_n");
+    names.push_back("aux");
+    if (!factors.empty()) {
+      names.insert(names.end(), factors.begin(), factors.end());
+      for (const std::string& f : factors) names.push_back("eta_sd_" + f.substr(4));
+      names.push_back("alarm_story");
+    }
+  } else if (mode == "hybrid") {
+    for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
+  }
+  names.insert(names.end(), floors.begin(), floors.end());
+  return names;
+}
+
+int event_series(const std::vector<std::string>& names, const DeviceSeries& d) {
+  if (!d.particle || !d.contact) return -1;
+  const auto it = std::find(names.begin(), names.end(), "contact_force_n");
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+namespace {
+
+// The device's panel: its kind, the floor it sits on (if on the page) and
+// the VI NES box's walls, as the scene's model designs them.
+void set_device(const Bench& b, PageMeta* m) {
+  const SceneParams& p = b.scene.params;
+  const ModelInfo info = build_engine(p, b.scene.scalar, b.scene.path)->info();
+  m->device = p.device.kind == DeviceKind::kTmd ? "tmd" : "vines";
+  const int f = info.device_floor;
+  if (f == p.frame.stories) m->device_floor_series = "x_top_m";
+  else if (std::find(b.opt.floors.begin(), b.opt.floors.end(), f) != b.opt.floors.end())
+    m->device_floor_series = "x_" + std::to_string(f) + "_m";
+  if (p.device.kind == DeviceKind::kVines) m->gap_m = info.vines.gap;
+}
+
+}  // namespace
 
 BenchRows::BenchRows(const Bench& b) : b_(b) {
   const SceneParams& p = b.scene.params;
@@ -59,37 +113,27 @@ BenchRows::BenchRows(const Bench& b) : b_(b) {
   meta_.rate_hz = 1 / b.h;
   meta_.every = page_every(meta_.rate_hz);
   meta_.stories = p.frame.stories;
-  // Every mode: the ground, the top floor, the device, the node's flags;
-  // then the mode's own (the order of take()). The twin's estimator has no
-  // device model: it gives the device's force it estimates, not the sphere.
+  // The series (series_names), in the order take() gives their values. The
+  // twin's estimator has no device model: it gives the device's force it
+  // estimates, not the sphere.
   const bool estimator = b.opt.mode == HilMode::kTwin && b.cfg.estimator == link::TwinEstimator::kKalman;
-  device_ = device_series(meta_.mode, dev, estimator);
-  std::vector<std::string> names = {"ag_sent_mps2", "x_top_m"};
-  if (device_.particle) names.push_back("particle_x_m");
-  if (device_.contact) names.push_back("contact_force_n");
-  names.push_back("flags");
-  if (b.opt.mode == HilMode::kTwin) {
-    names.push_back("x_top_truth_m");
-    if (device_.truth_force) names.push_back("device_force_truth_n");
-    names.push_back("aux");
-    if (estimator) {
-      // The stories' factors, then the device's, as the twin's --csv names them.
-      params_ = meta_.stories + (dev == DeviceKind::kNone ? 0 : 1);
-      eta_.assign(static_cast<std::size_t>(params_), 1.0);
-      sd_.assign(static_cast<std::size_t>(params_), 0.0);
-      const auto param = [&](int j) {
-        return j < meta_.stories ? std::to_string(j + 1) : dev == DeviceKind::kTmd ? "tmd" : "device_floor_mass";
-      };
-      for (int j = 0; j < params_; ++j) names.push_back("eta_" + param(j));
-      for (int j = 0; j < params_; ++j) names.push_back("eta_sd_" + param(j));
-      names.push_back("alarm_story");
-    }
-  } else if (b.opt.mode == HilMode::kHybrid) {
-    for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
+  device_ = device_series(meta_.mode, dev, estimator, b.scene.scalar == Scalar::kFixed);
+  std::vector<std::string> factors, floors;
+  if (estimator) {
+    // The stories' factors, then the device's, as the twin's --csv names them.
+    params_ = meta_.stories + (dev == DeviceKind::kNone ? 0 : 1);
+    eta_.assign(static_cast<std::size_t>(params_), 1.0);
+    sd_.assign(static_cast<std::size_t>(params_), 0.0);
+    for (int j = 0; j < params_; ++j)
+      factors.push_back("eta_" + (j < meta_.stories          ? std::to_string(j + 1)
+                                  : dev == DeviceKind::kTmd ? std::string("tmd")
+                                                            : std::string("device_floor_mass")));
   }
-  // The floors chosen (--floors), last.
-  for (int f : b.opt.floors) names.push_back("x_" + std::to_string(f) + "_m");
+  for (int f : b.opt.floors) floors.push_back("x_" + std::to_string(f) + "_m");
+  const std::vector<std::string> names = series_names(meta_.mode, device_, factors, floors);
+  event_ = event_series(names, device_);
   for (const std::string& n : names) meta_.series.push_back(describe(n, meta_.mode, dev));
+  if (dev != DeviceKind::kNone) set_device(b, &meta_);
 }
 
 void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) {

@@ -89,36 +89,32 @@ void load_run(const std::string& path, Hub* hub) {
   m.every = page_every(m.rate_hz);
   // The series in the order the live page has them (rows.cpp).
   const DeviceSeries ds = device_series(m.mode, device, col.count("alarm_story") > 0);
-  std::vector<std::string> names = {"ag_sent_mps2", "x_top_m"};
-  if (ds.particle) names.push_back("particle_x_m");
-  if (ds.contact) names.push_back("contact_force_n");
-  names.push_back("flags");
-  if (twin) {
-    names.push_back("x_top_truth_m");
-    if (ds.truth_force) names.push_back("device_force_truth_n");
-    names.push_back("aux");
-    for (const std::string& h : header)
-      if (h.rfind("eta_", 0) == 0 && h.rfind("eta_sd_", 0) != 0) names.push_back(h);
-    for (const std::string& h : header)
-      if (h.rfind("eta_sd_", 0) == 0) names.push_back(h);
-    if (col.count("alarm_story")) names.push_back("alarm_story");
-  } else if (hybrid) {
-    for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
-  }
-  // The floors chosen (--floors), last: describe() knows them as floors.
-  for (const std::string& h : header)
+  std::vector<std::string> factors, floors;
+  for (const std::string& h : header) {
+    if (twin && h.rfind("eta_", 0) == 0 && h.rfind("eta_sd_", 0) != 0) factors.push_back(h);
+    // The floors chosen (--floors): describe() knows them as floors.
     if (describe(h, m.mode, device).panel == "floors" && h.rfind("x_", 0) == 0 && h != "x_top_m" &&
         h != "x_top_offline_m" && h != "x_top_truth_m")
-      names.push_back(h);
+      floors.push_back(h);
+  }
+  std::vector<std::string> names = series_names(m.mode, ds, factors, floors);
   // Those the file has (the tracking RMS: from the table and the top floor).
   names.erase(std::remove_if(names.begin(), names.end(),
                              [&](const std::string& n) { return n != "tracking_rms_pct" && !col.count(n); }),
               names.end());
   for (const std::string& n : names) m.series.push_back(describe(n, m.mode, device));
   m.stories = 0;  // not in the CSV
+  // The device's panel: the CSV names neither the device's floor nor its
+  // box, so the page draws it relative to the top floor (labelled so) and
+  // without the walls.
+  if (device != DeviceKind::kNone) {
+    m.device = device == DeviceKind::kTmd ? "tmd" : "vines";
+    m.device_floor_series = "x_top_m";
+  }
   hub->set_header(sse_event("meta", to_json(m).dump()));
   // The frames: the samples received, kept as the live run keeps them.
   Decimator dec(m.every, kFrameSamples, names.size());
+  const int contact = event_series(names, ds);
   RunningTracking tracking;
   std::vector<double> v;
   std::string event;
@@ -126,9 +122,9 @@ void load_run(const std::string& path, Hub* hub) {
     if (at(r, "received") == 0) continue;
     const auto k = static_cast<long long>(at(r, "k"));
     if (hybrid) tracking.add(at(r, "x_top_m"), at(r, "table_x_m"));
-    if (!dec.keeps(k)) continue;
     v.clear();
     for (const std::string& n : names) v.push_back(n == "tracking_rms_pct" ? tracking.pct() : rows[r][col.at(n)]);
+    if (!dec.keeps(k, contact >= 0 && v[static_cast<std::size_t>(contact)] != 0)) continue;
     if (dec.add(k, v, &event)) hub->publish(std::move(event));
   }
   if (dec.flush(&event)) hub->publish(std::move(event));

@@ -12,7 +12,7 @@ void PageWatch::start(const Bench& b) {
 void PageWatch::step(long long k, const HilRecord& rec) {
   // Every sample updates what is held (the twin's factors), kept or not.
   rows_->take(k, rec, &row_);
-  if (dec_->keeps(k) && dec_->add(k, row_, &event_)) hub_.publish(std::move(event_));
+  if (dec_->keeps(k, rows_->event(row_)) && dec_->add(k, row_, &event_)) hub_.publish(std::move(event_));
 }
 
 void PageWatch::finish(const HilReport& r) {

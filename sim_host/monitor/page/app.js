@@ -1,10 +1,11 @@
 // The monitoring page: the run's events (/events, Server-Sent Events) into
 // uPlot charts. What it received is kept in window.vinesPage (the browser
 // test reads it back): meta, k (the samples kept), data[name] (one array per
-// series), alarms (the alarm history), report, ended.
+// series), derived[label] (the lines computed from them), alarms (the alarm
+// history), report, ended.
 "use strict";
 
-const page = { meta: null, k: [], t: [], data: {}, alarms: [], report: null, ended: false };
+const page = { meta: null, k: [], t: [], data: {}, derived: {}, alarms: [], report: null, ended: false };
 window.vinesPage = page;
 
 // The charts, one per panel, in this order; each its title.
@@ -19,7 +20,7 @@ const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"
 // Node flags (firmware/include/vines/link/messages.hpp).
 const FLAG_RESIDUAL = 1 << 5, FLAG_DAMAGE = 1 << 8, FLAG_DEVICE = 1 << 9;
 
-const charts = [];  // {plot, names, bands}
+const charts = [];  // {plot, lines, banded}
 let dirty = false;
 
 function el(tag, cls, text) {
@@ -29,32 +30,59 @@ function el(tag, cls, text) {
   return e;
 }
 
-// One chart: the panel's series against time; stiffness and health with a
+// One chart: the panel's lines against time, each {label, stroke, dash,
+// get} (get: its values, one a kept sample); stiffness and health with a
 // band of eta +- 2 sd (two hidden series filled between).
-function makeChart(panel, title, series) {
+function makeChart(panel, title, unit, lines, banded) {
   const box = el("div", "panel");
   box.appendChild(el("h2", null, title));
   document.getElementById("charts").appendChild(box);
-  const banded = panel === "stiffness" || panel === "health";
   const opts = {
     width: 540, height: 200, legend: { live: true },
     scales: { x: { time: false } },
-    axes: [{ label: "t [s]" }, { label: series[0].unit, size: 60 }],
+    axes: [{ label: "t [s]" }, { label: unit, size: 60 }],
     series: [{ label: "t" }], bands: [],
   };
-  series.forEach((s, i) => opts.series.push({ label: s.label, stroke: COLORS[i % COLORS.length], width: 1 }));
+  lines.forEach((l, i) => opts.series.push({ label: l.label, stroke: l.stroke || COLORS[i % COLORS.length],
+                                             width: 1, dash: l.dash }));
   if (banded) {
-    series.forEach((s, i) => {
+    lines.forEach((l, i) => {
       const hi = opts.series.length;
-      opts.series.push({ label: s.label + " +2sd", stroke: "transparent", show: true });
-      opts.series.push({ label: s.label + " -2sd", stroke: "transparent", show: true });
+      opts.series.push({ label: l.label + " +2sd", stroke: "transparent", show: true });
+      opts.series.push({ label: l.label + " -2sd", stroke: "transparent", show: true });
       opts.bands.push({ series: [hi, hi + 1], fill: COLORS[i % COLORS.length] + "22" });
     });
   }
   const plot = new uPlot(opts, [[]], box);
   // The bands' bounds stay out of the legend.
-  box.querySelectorAll(".u-legend .u-series").forEach((row, i) => { if (i > series.length) row.style.display = "none"; });
-  charts.push({ plot, names: series.map((s) => s.name), banded });
+  box.querySelectorAll(".u-legend .u-series").forEach((row, i) => { if (i > lines.length) row.style.display = "none"; });
+  charts.push({ plot, lines, banded });
+}
+
+// A series of the run as a chart's line.
+const seriesLine = (s) => ({ label: s.label, name: s.name, get: () => page.data[s.name] });
+
+// The device's panel: the sphere (or the TMD's mass) relative to the floor
+// it sits on, and the VI NES box's walls at +- the free travel, when the
+// page has that floor; otherwise the series as the run gives them.
+function deviceLines(series) {
+  const dev = page.meta.device || {}, floor = dev.floor_series;
+  const mass = series.find((s) => s.name === "particle_x_m");
+  if (!mass || !floor || !page.data[floor]) return series.map(seriesLine);
+  const what = dev.kind === "tmd" ? "TMD mass" : "sphere";
+  const floorLabel = page.meta.series.find((s) => s.name === floor).label;
+  // Derived lines grow with the data (each value computed once).
+  const derived = (label, at, style) => {
+    const cache = (page.derived[label] = []);
+    return Object.assign({ label, get() { for (let i = cache.length; i < page.t.length; ++i) cache.push(at(i)); return cache; } },
+                         style);
+  };
+  const x = page.data.particle_x_m, f = page.data[floor];
+  const lines = [derived(`${what} relative to the ${floorLabel}`, (i) => x[i] - f[i])];
+  if (dev.gap_m > 0)
+    for (const sign of [-1, 1])
+      lines.push(derived(sign < 0 ? "left wall" : "right wall", () => sign * dev.gap_m, { stroke: "#555", dash: [6, 4] }));
+  return lines;
 }
 
 function onMeta(m) {
@@ -64,7 +92,9 @@ function onMeta(m) {
     `${m.live ? "live" : "replay of"} ${m.source}, ${m.mode}, ${m.rate_hz} Hz (every ${m.every}th sample)`;
   for (const [panel, title] of PANELS) {
     const series = m.series.filter((s) => s.panel === panel);
-    if (series.length) makeChart(panel, title, series);
+    if (!series.length) continue;
+    const lines = panel === "device" ? deviceLines(series) : series.map(seriesLine);
+    makeChart(panel, title, series[0].unit, lines, panel === "stiffness" || panel === "health");
   }
 }
 
@@ -100,18 +130,20 @@ function redraw() {
   if (dirty) {
     dirty = false;
     for (const c of charts) {
-      const cols = [page.t].concat(c.names.map((n) => page.data[n]));
+      const cols = [page.t].concat(c.lines.map((l) => l.get()));
       if (c.banded) {
-        for (const n of c.names) {
-          const eta = page.data[n], sd = page.data[n.replace("eta_", "eta_sd_")] || [];
+        for (const l of c.lines) {
+          const eta = page.data[l.name], sd = page.data[l.name.replace("eta_", "eta_sd_")] || [];
           cols.push(eta.map((v, i) => v + 2 * (sd[i] || 0)), eta.map((v, i) => v - 2 * (sd[i] || 0)));
         }
       }
       c.plot.setData(cols);
     }
     const banner = document.getElementById("alarm");
+    // Red for damage or a detuned device, amber for the residual alone (a
+    // model or noise warning, not a finding about the building).
     banner.textContent = lastAlarm || "no alarm";
-    banner.className = lastAlarm ? "on" : "";
+    banner.className = /damage|device/.test(lastAlarm) ? "on" : lastAlarm ? "warn" : "";
     document.getElementById("history").textContent = page.alarms
       .map((a) => `t = ${a.t.toFixed(2)} s: ${a.alarm || "cleared"}`).join("\n") || "none";
     document.getElementById("status").textContent =
