@@ -4,15 +4,18 @@ that measured it, stamped with the date, the commit and the machine, so that no
 figure in the guides is edited by hand (docs/figures/README.md).
 
 As a module (tools/mcu_report.py, tools/twin_benchmark.py): stamp() and write().
-As a command, the work-precision table of a `vines bench --csv` file:
+As a command, the work-precision table of a `vines bench --csv` file, or the
+bench's deadlines with and without the monitoring page (tools/page_deadlines.sh):
 
   figures.py bench BENCH.csv [--out docs/figures/bench.md] [--command CMD]
+  figures.py deadlines RUNS.jsonl [--out docs/figures/page_deadlines.md] [--command CMD]
 
 Exit code 2, with a message naming the path, on a missing file or column.
 """
 import argparse
 import csv
 import datetime
+import json
 import os
 import platform
 import subprocess
@@ -137,6 +140,37 @@ def bench_body(path):
     return body
 
 
+# ---- the bench's deadlines with and without the monitoring page ----
+
+DEADLINE_KINDS = ["no page", "served, no client", "stream read, no browser", "page open"]
+
+
+def deadlines_body(path):
+    """The table of tests/browser/deadlines.js's JSON lines: one row a run."""
+    try:
+        with open(path) as f:
+            runs = [json.loads(line) for line in f if line.strip()]
+    except OSError as e:
+        fail("figures.py", f"{path}: {e.strerror}")
+    except json.JSONDecodeError as e:
+        fail("figures.py", f"{path}: line {e.lineno}: not JSON ({e.msg})")
+    for r in runs:
+        for key in ("kind", "round", "load", "steps", "deadline_misses", "latency_us"):
+            if key not in r:
+                fail("figures.py", f"{path}: a run without '{key}'")
+    if not runs:
+        fail("figures.py", f"{path}: no runs")
+    rows = []
+    for r in sorted(runs, key=lambda r: (DEADLINE_KINDS.index(r["kind"]), r["round"])):
+        lat = r["latency_us"]
+        page = r.get("page_samples")
+        rows.append([r["kind"], r["round"], f"{r['load']:.2f}", r["steps"], r["deadline_misses"],
+                     f"{100 * r['deadline_misses'] / r['steps']:.2f}",
+                     f"{lat['mean']:.0f} / {lat['p99']:.0f} / {lat['max']:.0f}", "-" if page is None else page])
+    return table(["run", "round", "load before", "steps", "deadline misses", "misses %",
+                  "latency mean / p99 / max (us)", "samples on the page"], rows)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
@@ -145,7 +179,23 @@ def main():
     b.add_argument("csv")
     b.add_argument("--out", default=os.path.join(FIGURES, "bench.md"))
     b.add_argument("--command", default="bash tools/bench.sh", help="the command the stamp names")
+    d = sub.add_parser("deadlines", help="the bench's deadlines with and without the page (tools/page_deadlines.sh)")
+    d.add_argument("jsonl")
+    d.add_argument("--out", default=os.path.join(FIGURES, "page_deadlines.md"))
+    d.add_argument("--command", default="bash tools/page_deadlines.sh")
     a = ap.parse_args()
+    if a.what == "deadlines":
+        write(a.out, "The bench's deadlines with and without the monitoring page", a.command,
+              ["`vines hil data/scenes/elcentro_vines.toml --realtime` (1 kHz, host node): without `--serve`,",
+               "with `--serve` and no client, with a client reading the event stream without drawing it, and",
+               "with the page open in headless chromium on the same machine for the whole run",
+               "(`tests/browser/deadlines.js`); rounds interleaved. A deadline is missed when a sample's",
+               "telemetry is not back within one sensor period; latency is from the sample's send to its",
+               "telemetry. Samples on the page: the kept samples (every 5th, and each in contact) the client",
+               "received.", ""]
+              + deadlines_body(a.jsonl))
+        print(f"figures.py: wrote {a.out}")
+        return
     write(a.out, "Work-precision: `vines bench` on the El Centro scenes", a.command,
           ["Wall time per full run (median of repeats, one core), peak top-floor displacement error",
            "against `data/reference/`, contacts (the reference's in `vines reference`).", ""]
