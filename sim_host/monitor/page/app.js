@@ -126,9 +126,14 @@ function onFrame(f) {
   dirty = true;
 }
 
-function redraw() {
-  if (dirty) {
+// At most four redraws a second: each draws every chart whole, and the
+// browser often shares the machine with the bench.
+const REDRAW_MS = 250;
+let lastDraw = 0;
+function redraw(now) {
+  if (dirty && (now - lastDraw >= REDRAW_MS || page.ended)) {
     dirty = false;
+    lastDraw = now;
     for (const c of charts) {
       const cols = [page.t].concat(c.lines.map((l) => l.get()));
       if (c.banded) {
