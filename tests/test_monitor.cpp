@@ -149,6 +149,29 @@ TEST(Hub, EveryClientGetsTheHeaderThenEveryEventInOrder) {
   EXPECT_EQ(hub.published(), 5000);
 }
 
+// --serve-hold: the server waits for a client that comes after the run and
+// reads it to its end, and no longer than it is told when none comes.
+TEST(Hub, WaitsForAClientToReadTheWholeRun) {
+  Hub hub;
+  hub.set_header("H");
+  hub.publish("e");
+  hub.close();
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(hub.wait_until_read(100ms));  // nobody came
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, 100ms);
+  std::thread late([&] {
+    std::this_thread::sleep_for(200ms);
+    const std::optional<long long> c = hub.join();
+    Hub::Next last{};
+    EXPECT_EQ(read_all(hub, *c, &last).size(), 2u);
+    EXPECT_EQ(last, Hub::Next::kEnd);
+    hub.leave();
+  });
+  EXPECT_TRUE(hub.wait_until_read(10000ms));
+  late.join();
+  EXPECT_EQ(hub.clients(), 0);
+}
+
 // At most max_clients at once; one leaving frees its place.
 TEST(Hub, BoundsItsClients) {
   Hub hub(HubLimits{2, 1 << 20});

@@ -1,6 +1,7 @@
 // `vines hil SCENE.toml`: the hardware-in-the-loop bench around `vines node`.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iterator>
@@ -26,6 +27,7 @@ struct HilArgs {
   bool as_json = false;
   bool accept_degraded = false;
   std::string serve;              // --serve ("" : no page)
+  double serve_hold_s = 0;        // --serve-hold (0: the clients then connected get 2 s)
   const CLI::App* cmd = nullptr;  // for the options given (check_options)
 };
 
@@ -46,6 +48,8 @@ void check_options(const HilArgs& a) {
     if (g == kHybridGroup && o.mode != host::HilMode::kHybrid)
       throw CLI::ValidationError(opt->get_name(), "a hybrid option: it needs --mode hybrid");
   }
+  if (a.cmd->count("--serve-hold") > 0 && a.serve.empty())
+    throw CLI::ValidationError("--serve-hold", "it needs --serve");
   if (a.cmd->count("--image") > 0 && o.node.rfind("qemu:", 0) != 0)
     throw CLI::ValidationError("--image", "a board image: it needs --node qemu:TARGET");
 }
@@ -54,14 +58,18 @@ int hil(const HilArgs& a) {
   check_options(a);
   const host::Scene scene = host::load_scene(a.scene_path);
   // The page (--serve) listens before the bench starts; after the run its
-  // clients get up to 2 s to read the report.
+  // clients get up to 2 s to read the report, or with --serve-hold up to S
+  // for one to have read the whole run.
   std::unique_ptr<ServedPage> page;
   if (!a.serve.empty()) {
     page = std::make_unique<ServedPage>();
     page->listen("vines hil", a.serve);
   }
   const host::HilReport r = host::run_hil(scene, a.opt, page ? page->watch() : nullptr);
-  if (page) page->stop(std::chrono::milliseconds(2000));
+  if (page)
+    page->stop(a.serve_hold_s > 0 ? std::chrono::milliseconds(std::llround(1e3 * a.serve_hold_s))
+                                  : std::chrono::milliseconds(2000),
+               a.serve_hold_s > 0);
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
   else print_hil(r);
   if (!r.outputs_finite) return kRefused;
@@ -132,6 +140,11 @@ void add_hil(CLI::App& vines) {
   add_serve(*cmd, &a->serve,
             "serve the monitoring page while the bench runs; ADDRESS: [HOST:]PORT (HOST 127.0.0.1 unless given; "
             "PORT 0: any free one); read-only, at most 4 clients (docs/hil.md)");
+  cmd->add_option("--serve-hold", a->serve_hold_s,
+                  "after the run, keep the page up to S seconds for a client to read the whole run (a run in lock "
+                  "step may end before a browser opens the page; default: the clients then connected get 2 s)")
+      ->type_name("S")
+      ->check(number_in(1e-3, 1e6));
   add_accept_degraded(*cmd, &a->accept_degraded);
   cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
   add_number_list(*cmd, "--floors", &opt.floors, 1, 1000,

@@ -45,8 +45,8 @@ void ServedPage::listen(const std::string& command, const std::string& at) {
 ServedPage::~ServedPage() = default;
 host::HilWatch* ServedPage::watch() { return &impl_->watch; }
 void ServedPage::load(const std::string& path) { host::monitor::load_run(path, &impl_->hub); }
-void ServedPage::stop(std::chrono::milliseconds linger) {
-  if (impl_->server) impl_->server->stop(linger);
+void ServedPage::stop(std::chrono::milliseconds linger, bool hold) {
+  if (impl_->server) impl_->server->stop(linger, hold);
 }
 #else
 struct ServedPage::Impl {};
@@ -58,7 +58,7 @@ ServedPage::~ServedPage() = default;
 void ServedPage::listen(const std::string&, const std::string&) {}
 host::HilWatch* ServedPage::watch() { return nullptr; }
 void ServedPage::load(const std::string&) {}
-void ServedPage::stop(std::chrono::milliseconds) {}
+void ServedPage::stop(std::chrono::milliseconds, bool) {}
 #endif
 
 }  // namespace vines::cli

@@ -30,8 +30,9 @@ class ServedPage {
   host::HilWatch* watch();
   // vines view: the run's --csv (a file, or a folder with one) into the page.
   void load(const std::string& path);
-  // Gives the clients up to `linger` to read the last events, then stops.
-  void stop(std::chrono::milliseconds linger);
+  // Gives the clients up to `linger` to read the last events, then stops;
+  // with `hold`, up to `linger` for a client to have read the whole run.
+  void stop(std::chrono::milliseconds linger, bool hold = false);
 
  private:
   struct Impl;

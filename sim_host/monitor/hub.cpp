@@ -75,7 +75,12 @@ Hub::Next Hub::next(long long* cursor, std::vector<Event>* out, std::chrono::mil
   if (*cursor < first_) return Next::kBehind;
   for (auto i = static_cast<std::size_t>(*cursor - first_); i < log_.size(); ++i) out->push_back(log_[i]);
   *cursor = first_ + static_cast<long long>(log_.size());
-  if (out->empty() && closed_) return Next::kEnd;
+  if (out->empty() && closed_) {
+    ++finished_;
+    lock.unlock();
+    cv_.notify_all();
+    return Next::kEnd;
+  }
   return Next::kEvents;
 }
 
@@ -87,6 +92,11 @@ void Hub::count_dropped() {
 bool Hub::wait_until_no_clients(std::chrono::milliseconds wait) {
   std::unique_lock<std::mutex> lock(m_);
   return cv_.wait_for(lock, wait, [&] { return clients_ == 0; });
+}
+
+bool Hub::wait_until_read(std::chrono::milliseconds wait) {
+  std::unique_lock<std::mutex> lock(m_);
+  return cv_.wait_for(lock, wait, [&] { return finished_ > 0 && clients_ == 0; });
 }
 
 int Hub::clients() const {

@@ -53,6 +53,9 @@ class Hub {
   void count_dropped();
   // Waits up to `wait` for every client to leave; true if they did.
   bool wait_until_no_clients(std::chrono::milliseconds wait);
+  // Waits up to `wait` for a client to have read every event to the end
+  // and every client to have left; true if so.
+  bool wait_until_read(std::chrono::milliseconds wait);
 
   int clients() const;
   long long dropped() const;
@@ -71,6 +74,7 @@ class Hub {
   std::size_t bytes_ = 0;
   bool closed_ = false;
   int clients_ = 0;
+  int finished_ = 0;  // clients that read to the end
   long long dropped_ = 0;
   std::vector<std::string> pending_;  // the bench's only: waiting for the lock
 };

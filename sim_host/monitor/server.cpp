@@ -113,9 +113,10 @@ PageServer::~PageServer() { stop(std::chrono::milliseconds(0)); }
 
 std::string PageServer::url() const { return "http://" + host_ + ":" + std::to_string(port_) + "/"; }
 
-void PageServer::stop(std::chrono::milliseconds linger) {
+void PageServer::stop(std::chrono::milliseconds linger, bool hold) {
   if (!impl_->thread.joinable()) return;
-  impl_->hub.wait_until_no_clients(linger);
+  if (hold) impl_->hub.wait_until_read(linger);
+  else impl_->hub.wait_until_no_clients(linger);
   // A server stopped before it runs would run on: wait for it to run first.
   for (int i = 0; i < 2000 && !impl_->srv.is_running(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   impl_->srv.stop();

@@ -31,8 +31,9 @@ class PageServer {
   int port() const { return port_; }
   std::string url() const;
   // Gives the clients up to `linger` to read the hub's last events (close it
-  // first), then stops.
-  void stop(std::chrono::milliseconds linger);
+  // first), then stops. With `hold`, waits up to `linger` for a client to
+  // have read the whole run (one may not have come yet), then stops.
+  void stop(std::chrono::milliseconds linger, bool hold = false);
 
  private:
   struct Impl;

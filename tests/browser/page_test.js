@@ -191,11 +191,13 @@ async function hybrid(browser) {
 }
 
 // A bench run in lock step (as fast as the link allows: the run may end
-// before the page opens, which then gets it from the history), its page once
-// ended, the --json report and the --csv's columns.
+// before the page opens, which then gets it from the history: --serve-hold),
+// its page once ended, the --json report and the --csv's columns.
 async function lockStep(browser, name, args) {
   const csv = path.join(out, `${name}.csv`);
-  const run = start(["hil", ...args, "--serve", "0", "--csv", csv, "--json"]);
+  // --serve-hold: the run may end before the page opens; it is kept up
+  // until the page has read it all.
+  const run = start(["hil", ...args, "--serve", "0", "--serve-hold", "60", "--csv", csv, "--json"]);
   const page = await browser.newPage();
   const errors = [];
   page.on("pageerror", (e) => errors.push(String(e)));
