@@ -46,7 +46,8 @@ Series describe(const std::string& name, const std::string& mode, DeviceKind dev
       name.find_first_not_of("0123456789", 2) == name.size() - 2)
     return {name, "floor " + name.substr(2, name.size() - 4), "m", "floors"};
   if (name.rfind("eta_sd_", 0) == 0) return {name, "sd", "", "band"};
-  if (name == "eta_" + device_name) return {name, device_name, "", "health"};
+  if (name == "eta_" + device_name)
+    return {name, device == DeviceKind::kTmd ? "TMD spring (factor)" : "device floor's mass (factor)", "", "health"};
   if (name.rfind("eta_", 0) == 0) return {name, "story " + name.substr(4), "", "stiffness"};
   return {name, name, "", "other"};
 }

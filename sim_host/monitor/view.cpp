@@ -103,7 +103,10 @@ void load_run(const std::string& path, Hub* hub) {
                              [&](const std::string& n) { return n != "tracking_rms_pct" && !col.count(n); }),
               names.end());
   for (const std::string& n : names) m.series.push_back(describe(n, m.mode, device));
-  m.stories = 0;  // not in the CSV
+  // The stories: the twin estimator's story factors (eta_1 ...), else not in the CSV.
+  m.stories = static_cast<int>(std::count_if(factors.begin(), factors.end(), [](const std::string& f) {
+    return f.find_first_not_of("0123456789", 4) == std::string::npos;
+  }));
   // The device's panel: the CSV names neither the device's floor nor its
   // box, so the page draws it relative to the top floor (labelled so) and
   // without the walls.

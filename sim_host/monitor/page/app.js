@@ -43,6 +43,10 @@ function makeChart(panel, title, unit, lines, banded) {
     axes: [{ label: "t [s]" }, { label: unit, size: 60 }],
     series: [{ label: "t" }], bands: [],
   };
+  // The story in alarm on a scale of the stories (0: none), not auto-ranged
+  // around a line of zeros.
+  if (panel === "alarm")
+    opts.scales.y = { range: (u, min, max) => [0, Math.max(page.meta.stories || 0, max || 0, 1)] };
   lines.forEach((l, i) => opts.series.push({ label: l.label, stroke: l.stroke || COLORS[i % COLORS.length],
                                              width: 1, dash: l.dash }));
   if (banded) {
@@ -166,7 +170,9 @@ function onReport(r) {
     const tw = r.twin;
     lines.push(tw.detected ? `damage: story ${tw.story}, ${(100 * tw.size).toFixed(1)} %, at ${tw.detect_time_s.toFixed(2)} s`
                            : "no damage detected");
-    if (tw.device) lines.push(`device: ${JSON.stringify(tw.device)}`);
+    if (tw.device)
+      lines.push("device: " + Object.entries(tw.device)
+        .map(([k, v]) => `${k.replace(/_/g, " ")} ${typeof v === "number" ? +v.toPrecision(4) : v}`).join(", "));
   }
   if (r.hybrid) {
     const h = r.hybrid, f = (v) => (v === null || v === undefined ? "-" : v.toFixed(3));
