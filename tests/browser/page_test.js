@@ -63,9 +63,10 @@ function readCsv(file) {
 const pageData = (page) =>
   page.evaluate(() => {
     const p = window.vinesPage;
-    return { meta: p.meta, k: p.k, data: p.data, alarms: p.alarms, report: p.report, ended: p.ended,
+    return { meta: p.meta, k: p.k, data: p.data, derived: p.derived, alarms: p.alarms, report: p.report, ended: p.ended,
              banner: document.getElementById("alarm").textContent,
-             bannerClass: document.getElementById("alarm").className };
+             bannerClass: document.getElementById("alarm").className,
+             legend: Array.from(document.querySelectorAll(".u-legend .u-series")).map((e) => e.textContent) };
   });
 
 async function main() {
@@ -204,13 +205,7 @@ async function lockStep(browser, name, args) {
   await page.goto(await run.url);
   await page.waitForFunction(() => window.vinesPage.ended, { timeout: 60000 });
   await new Promise((r) => setTimeout(r, 300));  // a last redraw
-  const live = await page.evaluate(() => {
-    const p = window.vinesPage;
-    return { meta: p.meta, k: p.k, data: p.data, derived: p.derived, alarms: p.alarms,
-             banner: document.getElementById("alarm").textContent,
-             bannerClass: document.getElementById("alarm").className,
-             legend: Array.from(document.querySelectorAll(".u-legend .u-series")).map((e) => e.textContent) };
-  });
+  const live = await pageData(page);
   await page.screenshot({ path: path.join(out, `monitor_${name}.png`), fullPage: true });
   const exit = await run.exited;
   check(exit.code === 0, `${name}: vines hil exit ${exit.code}: ${run.stderrText}`);
@@ -242,7 +237,7 @@ async function deviceBox(browser) {
   const vpage = await browser.newPage();
   await vpage.goto(await view.url);
   await vpage.waitForFunction(() => window.vinesPage.ended, { timeout: 60000 });
-  const replay = await vpage.evaluate(() => ({ k: window.vinesPage.k, derived: window.vinesPage.derived }));
+  const replay = await pageData(vpage);
   view.kill("SIGINT");
   await view.exited;
   check(JSON.stringify(replay.k) === JSON.stringify(live.k), "replay: vines view keeps other samples");
