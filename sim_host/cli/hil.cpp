@@ -16,6 +16,7 @@
 #include "sim_host/cli/hil_print.hpp"
 #include "sim_host/cli/serve.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/modes/twin_baseline.hpp"
 #include "sim_host/scene/scene.hpp"
 
 namespace vines::cli {
@@ -48,6 +49,10 @@ void check_options(const HilArgs& a) {
     if (g == kHybridGroup && o.mode != host::HilMode::kHybrid)
       throw CLI::ValidationError(opt->get_name(), "a hybrid option: it needs --mode hybrid");
   }
+  if (!o.commission_path.empty() && o.estimator != host::HilEstimator::kKalman)
+    throw CLI::ValidationError("--commission", "it needs the estimator (--estimator kalman)");
+  if (!o.commission_path.empty() && !o.baseline_path.empty())
+    throw CLI::ValidationError("--commission", "a commissioning run is on the healthy building: no --baseline");
   if (a.cmd->count("--serve-hold") > 0 && a.serve.empty())
     throw CLI::ValidationError("--serve-hold", "it needs --serve");
   if (a.cmd->count("--image") > 0 && o.node.rfind("qemu:", 0) != 0)
@@ -70,6 +75,8 @@ int hil(const HilArgs& a) {
     page->stop(a.serve_hold_s > 0 ? std::chrono::milliseconds(std::llround(1e3 * a.serve_hold_s))
                                   : std::chrono::milliseconds(2000),
                a.serve_hold_s > 0);
+  if (!a.opt.commission_path.empty() && r.twin && r.twin->estimator != "none")
+    host::commission_twin(a.opt.commission_path, host::twin_building(scene, a.opt), *r.twin, scene.record.path);
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
   else print_hil(r);
   if (!r.outputs_finite) return kRefused;
@@ -246,6 +253,19 @@ void add_hil(CLI::App& vines) {
       ->type_name("TRUTH.toml")
       ->check(non_empty_path())
       ->group(twin);
+  cmd->add_option("--baseline", opt.baseline_path,
+                  "the healthy building's baseline that --commission runs wrote: the decision tests the change "
+                  "from it (default: from the nominal scene, the healthy stories and masses within "
+                  "--twin-healthy-tolerance and --twin-mass-tolerance of it)")
+      ->type_name("FILE")
+      ->check(non_empty_path())
+      ->group(twin);
+  cmd->add_option("--commission", opt.commission_path,
+                  "the run is on the healthy building: add its identified stories to this baseline file "
+                  "(created if missing; one run per healthy record)")
+      ->type_name("FILE")
+      ->check(non_empty_path())
+      ->group(twin);
   cmd->add_option("--truth-stiffness-scale", opt.truth_stiffness_scale,
                   "the measured building's eta_k, times the truth scene's (default 1)")
       ->type_name("ETA")
@@ -299,10 +319,17 @@ void add_hil(CLI::App& vines) {
       {"--twin-memory", {&tu.memory_s, "the losses' memory [s]"}},
       {"--twin-prior-sd", {&tu.prior_sd, "prior sd of each loss"}},
       {"--twin-max-step", {&tu.max_step, "largest change of a loss in one update"}},
-      {"--twin-kappa", {&tu.kappa, "alarm: loss beyond this many sd..."}},
-      {"--twin-loss-min", {&tu.loss_min, "...and beyond this loss (stories)"}},
-      {"--twin-device-loss-min", {&tu.device_loss_min, "the TMD spring's |loss| for its alarm"}},
-      {"--twin-hold", {&tu.hold_s, "held this long [s]"}},
+      {"--twin-kappa", {&tu.kappa, "the TMD spring's alarm: |loss| beyond this many sd..."}},
+      {"--twin-device-loss-min", {&tu.device_loss_min, "...and beyond this |loss|"}},
+      {"--twin-hold", {&tu.hold_s, "an alarm's candidate held this long [s]"}},
+      {"--twin-threshold", {&tu.threshold, "damage: one-story statistic of the absolute test"}},
+      {"--twin-threshold-change", {&tu.threshold_change, "...of a change test (damage during the record)"}},
+      {"--twin-two-story", {&tu.two_story, "two stories: the pair's statistic beyond the best story's by this"}},
+      {"--twin-separation", {&tu.separation, "a story named: its statistic beyond the next story's by this"}},
+      {"--twin-inflation", {&tu.inflation, "the estimate's covariance times this in the tests"}},
+      {"--twin-drift-sd", {&tu.drift_sd, "a change test's model drift per story"}},
+      {"--twin-healthy-tolerance", {&tu.healthy_tolerance, "no baseline: the healthy stories within this of the drawing"}},
+      {"--twin-mass-tolerance", {&tu.mass_tolerance, "no baseline: the floors' masses within this of the drawing"}},
   };
   for (const auto& [name, k] : knobs)
     cmd->add_option(name, *k.first, k.second)->type_name("X")->check(number_in(1e-9, 1e6))->group(tuning);

@@ -26,11 +26,18 @@ void print_twin(const host::HilTwinReport& t) {
   if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
   std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
   if (t.estimator == "none") return;
-  if (t.detected && t.story && t.size)
-    std::printf("    DAMAGE: story %d, loss %.1f %% at %.2f s (%.2f s after strong motion starts at %.2f s)\n", *t.story,
-                100 * *t.size, *t.detect_time_s, *t.detect_delay_s, t.strong_motion_start_s);
-  else
+  if (t.detected) {
+    std::printf("    DAMAGE:");
+    if (!t.story_identified) std::printf(" story not identified, loss about %.1f %%", 100 * t.size.value_or(0));
+    for (std::size_t i = 0; i < t.stories.size(); ++i)
+      std::printf("%s story %d, loss %.1f %%", i ? "," : "", t.stories[i], 100 * t.sizes[i]);
+    std::printf(" at %.2f s (%.2f s after strong motion starts at %.2f s)", *t.detect_time_s, *t.detect_delay_s,
+                t.strong_motion_start_s);
+    if (t.onset_s) std::printf("; onset %.1f s", *t.onset_s);
+    std::printf("\n");
+  } else {
     std::printf("    no damage detected\n");
+  }
   std::printf("    eta_k (sd) by story:");
   for (std::size_t i = 0; i < t.eta_k.size(); ++i) std::printf(" %.3f (%.3f)", t.eta_k[i], t.eta_k_sd[i]);
   std::printf("\n    roof displacement NRMSE %s (steady-state sd %.3g mm)\n",

@@ -67,6 +67,8 @@ struct HilOptions {
   double measure_bias_mps2 = 0;      // each sensor's bias drawn from N(0, this^2)
   double adc_lsb_mps2 = 0;           // ADC resolution (0: none)
   TwinTuning tuning;
+  std::string baseline_path;         // the decision's baseline (twin_baseline.hpp; "": the drawing)
+  std::string commission_path;       // the run's estimates added to this baseline file
   double drift_limit_m = 0;          // every story (0: no alarm)
   double residual_limit_mps2 = 0.05;
   double residual_window_s = 1.0;

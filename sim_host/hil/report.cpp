@@ -50,7 +50,11 @@ json to_json(const HilTwinReport& t) {
   if (t.estimator != "none")
     j.update({{"detected", t.detected},
               {"story", t.story ? json(*t.story) : json(nullptr)},
+              {"story_identified", t.story_identified},
+              {"stories", t.stories},
+              {"sizes", t.sizes},
               {"size", to_json(t.size)},
+              {"onset_s", to_json(t.onset_s)},
               {"detect_time_s", to_json(t.detect_time_s)},
               {"detect_delay_s", to_json(t.detect_delay_s)},
               {"eta_k", t.eta_k},

@@ -84,8 +84,12 @@ struct HilTwinReport {
   std::vector<int> sensors;
   std::vector<double> noise_sd_mps2;
   bool detected = false;
-  std::optional<int> story;                // 1-based
+  std::optional<int> story;                // 1-based; none when detected with no story identified
+  bool story_identified = false;           // detected and a story named
+  std::vector<int> stories;                // the stories named (one or two), 1-based
+  std::vector<double> sizes;               // their losses
   std::optional<double> size, detect_time_s, detect_delay_s;
+  std::optional<double> onset_s;           // when the node estimates the change happened
   double strong_motion_start_s = 0;
   std::vector<double> eta_k, eta_k_sd;     // at the end, per story
   std::optional<double> roof_displacement_nrmse;  // RMS error over the truth's RMS

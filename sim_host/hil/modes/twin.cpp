@@ -8,6 +8,7 @@
 
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/modes/twin_baseline.hpp"
 #include "sim_host/run/drive.hpp"
 #include "vines/twin/image.hpp"
 
@@ -125,7 +126,11 @@ TwinBench make_twin_bench(const Scene& scene, const HilOptions& o, const Excitat
   const ModelInfo ni = nominal->info();
   tr.particle_mass = ni.vines.mass;  // the sphere the node's scene designs
   if (ni.tmd.omega > 0 && truth.params.device.kind == DeviceKind::kTmd) tr.tmd_frequency_factor = ti.tmd.omega / ni.tmd.omega;
-  if (o.estimator == HilEstimator::kKalman) tb.design = design_twin(scene.params, ni, tb.sensors, tb.noise_sd, o.tuning);
+  if (o.estimator == HilEstimator::kKalman) {
+    TwinBaselineStats base;
+    if (!o.baseline_path.empty()) base = load_twin_baseline(o.baseline_path, twin_building(scene, o), o.tuning);
+    tb.design = design_twin(scene.params, ni, tb.sensors, tb.noise_sd, o.tuning, o.baseline_path.empty() ? nullptr : &base);
+  }
   return tb;
 }
 

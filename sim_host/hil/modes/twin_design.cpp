@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "sim_host/hil/modes/twin_model_error.hpp"
 #include "sim_host/scene/frame.hpp"
 #include "vines/link/wire.hpp"
 #include "vines/numeric/expm.hpp"
@@ -164,7 +165,7 @@ Mat riccati(const Mat& A, const Mat& Cm, const Mat& Q, const Mat& R) {
 }  // namespace
 
 TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::vector<int>& sensors,
-                       const std::vector<double>& noise_sd, const TwinTuning& t) {
+                       const std::vector<double>& noise_sd, const TwinTuning& t, const TwinBaselineStats* baseline) {
   const int ny = static_cast<int>(sensors.size());
   if (ny < 1 || ny > twin::kMaxSensors) throw std::runtime_error("--sensors: 1 to 8 floors");
   const double h = 1.0 / p.loop.sensor_rate_hz;
@@ -214,7 +215,13 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kForget] = std::exp(-h / t.memory_s);
   set[twin::kUpdateSteps] = std::max(1.0, std::round(t.update_s / h));
   set[twin::kKappa] = t.kappa;
-  set[twin::kLossMin] = t.loss_min;
+  set[twin::kThreshold] = t.threshold;
+  set[twin::kThresholdChange] = t.threshold_change;
+  set[twin::kTwoStory] = t.two_story;
+  set[twin::kSeparation] = t.separation;
+  set[twin::kInflation] = t.inflation;
+  set[twin::kDriftVar] = t.drift_sd * t.drift_sd;
+  set[twin::kSnapSteps] = std::max(1.0, std::round(t.snapshot_s / h));
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);
@@ -247,6 +254,22 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   put(c.prior_sd.cwiseAbs2().cwiseInverse().transpose());
   put((c.prior_sd * (t.max_step / t.prior_sd)).transpose());
   put(S.diagonal().transpose());
+  // The decision's baseline and the model's error covariance of the stories.
+  const int n = d.stories;
+  Vec base = Vec::Zero(n);
+  const double cd = p.frame.damping == DampingRule::kStiffnessProportional ? p.frame.stiffness_damping_s : 0.0;
+  const Mat masses = mass_effect_covariance(build_host_frame(p.frame), cd, sensors, t.mass_tolerance);
+  Mat sigma0 = masses + Mat::Identity(n, n) * (t.healthy_tolerance * t.healthy_tolerance / 3.0);
+  if (baseline) {
+    for (int a = 0; a < n; ++a) {
+      base(a) = baseline->loss[static_cast<std::size_t>(a)];
+      for (int b = 0; b < n; ++b) sigma0(a, b) = baseline->cov[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)];
+    }
+    if (baseline->runs == 1) sigma0 += masses;
+    sigma0 = 0.5 * (sigma0 + sigma0.transpose()).eval();
+  }
+  put(base.transpose());
+  put(sigma0);
   if (!w.ok() || w.size() != buf.size()) throw std::runtime_error("the twin image: wrong size (a bug)");
   out.image = std::move(buf);
   return out;

@@ -27,11 +27,33 @@ struct TwinTuning {
   double prior_sd = 0.2;         // prior sd of each loss
   double update_s = 0.05;        // parameter update period
   double max_step = 0.002;       // largest change of a loss in one update (a trust region)
-  double kappa = 4;              // alarm: loss beyond kappa sd...
-  double loss_min = 0.05;        // ...and beyond 5 % (stories)
-  double device_loss_min = 0.1;  // the TMD spring: |loss| beyond 10 % (5 % in frequency)
-  double hold_s = 2.0;           // held this long
+  double kappa = 4;              // the TMD spring's alarm: |loss| beyond kappa sd...
+  double device_loss_min = 0.1;  // ...and beyond 10 % (5 % in frequency)
+  double hold_s = 2.0;           // an alarm's candidate held this long
+  // The stories' decision (twin/decision.hpp): thresholds on the one-story
+  // statistic (chi-square, one degree of freedom, for one test), the
+  // margins naming two stories or one, the estimate's covariance inflation,
+  // the change tests' drift, and the model's error without a baseline
+  // (healthy stories within 3 % of the drawing, masses within 2 %, each
+  // uniform).
+  double threshold = 25;         // absolute test
+  double threshold_change = 25;  // change tests
+  double two_story = 10.8;       // a pair beyond the best story by this (chi-square 1 dof, 0.1 %)
+  double separation = 4;         // a story named beyond the next by this
+  double inflation = 4;          // the estimate's covariance times this
+  double drift_sd = 0.005;       // a change test's model drift per story
+  double snapshot_s = 1.0;       // the change tests' snapshots
+  double healthy_tolerance = 0.03;  // no baseline: the healthy stories within this of the drawing...
+  double mass_tolerance = 0.02;     // ...and the floors' masses (uniform; twin_model_error.hpp)
   double innov_window_s = 2.0;   // the innovations' running mean square
+};
+
+// A commissioning baseline (twin_baseline.hpp): the stories' losses the
+// healthy building's runs identified, and their covariance.
+struct TwinBaselineStats {
+  std::vector<double> loss;                // per story
+  std::vector<std::vector<double>> cov;    // stories x stories
+  int runs = 0;                            // healthy runs it holds
 };
 
 struct TwinDesign {
@@ -43,7 +65,12 @@ struct TwinDesign {
 // sensors: 1-based floors; noise_sd: each sensor's noise [m/s^2 RMS];
 // info: the nominal scene's built model (device design). Throws
 // std::runtime_error naming the input when the design cannot be made.
+// baseline: none (nullptr) leaves the nominal scene as the healthy
+// building, the model's error the healthy stories' and the masses' effect
+// (twin_model_error.hpp) within the tuning's tolerances; a baseline of one
+// run has the masses' effect added (one record cannot show its spread).
 TwinDesign design_twin(const SceneParams& nominal, const ModelInfo& info, const std::vector<int>& sensors,
-                       const std::vector<double>& noise_sd, const TwinTuning& tuning);
+                       const std::vector<double>& noise_sd, const TwinTuning& tuning,
+                       const TwinBaselineStats* baseline = nullptr);
 
 }  // namespace vines::host

@@ -15,11 +15,12 @@ using link::Telemetry;
 // The estimator's spring factors as they come in (one a step, in turn): each
 // held from its last telemetry.
 struct Factors {
-  explicit Factors(int np) : eta(static_cast<std::size_t>(np), 1.0), sd(static_cast<std::size_t>(np), 0.0) {}
+  explicit Factors(int np)
+      : eta(static_cast<std::size_t>(np), 1.0), sd(static_cast<std::size_t>(np), 0.0), stat(static_cast<std::size_t>(np), 0.0) {}
   void take(const Telemetry& t) {
-    if (t.est_index < eta.size()) eta[t.est_index] = t.est_eta, sd[t.est_index] = t.est_sd;
+    if (t.est_index < eta.size()) eta[t.est_index] = t.est_eta, sd[t.est_index] = t.est_sd, stat[t.est_index] = t.est_stat;
   }
-  std::vector<double> eta, sd;
+  std::vector<double> eta, sd, stat;  // stat: a story's statistic in the decision's leading test
 };
 
 // Robust sd of a series (1.4826 x its median absolute value).
@@ -70,15 +71,21 @@ class TwinMode : public BenchMode {
     }
     for (int j = 0; j < np; ++j) c.names.push_back("eta_" + param_name(j));
     for (int j = 0; j < np; ++j) c.names.push_back("eta_sd_" + param_name(j));
+    for (int j = 0; j < stories(); ++j) c.names.push_back("stat_" + param_name(j));
+    c.names.push_back("stat_threshold");
     c.names.push_back("alarm_story");
     Factors f(np);
     int alarm = 0;
+    double threshold = 0;
     for (long long k = 0; k < rec.samples; ++k) {
       const auto i = static_cast<std::size_t>(k);
       if (rec.got[i]) f.take(rec.tel[i]), alarm = rec.tel[i].alarm_story;
       std::vector<double> row = {tb_.truth.roof_x[i], tb_.truth.device_force[i]};
       row.insert(row.end(), f.eta.begin(), f.eta.end());
       row.insert(row.end(), f.sd.begin(), f.sd.end());
+      row.insert(row.end(), f.stat.begin(), f.stat.begin() + stories());
+      if (rec.got[i]) threshold = rec.tel[i].stat_threshold;
+      row.push_back(threshold);
       row.push_back(alarm);
       c.rows.push_back(std::move(row));
     }
@@ -148,9 +155,18 @@ class TwinMode : public BenchMode {
     tw->eta_k.assign(f.eta.begin(), f.eta.begin() + n);
     tw->eta_k_sd.assign(f.sd.begin(), f.sd.begin() + n);
     tw->detected = tw->detect_time_s.has_value();
-    if (tw->detected && last && last->alarm_story > 0) {
-      tw->story = last->alarm_story;
-      tw->size = 1.0 - f.eta[static_cast<std::size_t>(*tw->story - 1)];
+    if (tw->detected && last) {
+      // The decision's last word: the story named (none: damage, story not
+      // identified), a second one, their sizes, the onset.
+      tw->story_identified = last->alarm_story > 0;
+      if (tw->story_identified) {
+        tw->story = last->alarm_story;
+        tw->stories.push_back(last->alarm_story);
+        tw->sizes.push_back(last->damage_size);
+        if (last->second_story > 0) tw->stories.push_back(last->second_story), tw->sizes.push_back(last->second_size);
+      }
+      tw->size = last->damage_size;
+      if (last->onset_s >= 0) tw->onset_s = last->onset_s;
       tw->detect_delay_s = *tw->detect_time_s - tb_.strong_motion_start_s;
     }
     device(rec, f, device_alarm, &tw->device);

@@ -15,7 +15,7 @@
 
 namespace vines::link {
 
-inline constexpr std::uint8_t kProtocolVersion = 4;
+inline constexpr std::uint8_t kProtocolVersion = 5;
 inline constexpr std::size_t kHeaderBytes = 4, kCrcBytes = 4;
 inline constexpr std::size_t kMaxPayload = 480;
 inline constexpr std::size_t kMaxRaw = kHeaderBytes + kMaxPayload + kCrcBytes;

@@ -85,6 +85,12 @@ struct Telemetry {
   // and the story in alarm (1-based, 0: none).
   std::uint8_t est_index = 0, alarm_story = 0;
   double est_eta = 0, est_sd = 0;
+  // Its decision (twin/decision.hpp): est_index's one-story statistic in
+  // the leading test and the absolute test's threshold; a second story
+  // (1-based, 0: none), the sizes of both; the onset (s, -1: none).
+  double est_stat = 0, stat_threshold = 0;
+  std::uint8_t second_story = 0;
+  double damage_size = 0, second_size = 0, onset_s = -1;
 };
 
 // The node's deadline monitor: every step's model work timed on the node's
@@ -196,6 +202,12 @@ void layout(IO& io, M& t, Telemetry*) {
   io.field(t.alarm_story);
   io.field(t.est_eta);
   io.field(t.est_sd);
+  io.field(t.est_stat);
+  io.field(t.stat_threshold);
+  io.field(t.second_story);
+  io.field(t.damage_size);
+  io.field(t.second_size);
+  io.field(t.onset_s);
 }
 
 template <class IO, class M>

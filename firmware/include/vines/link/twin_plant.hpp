@@ -68,7 +68,13 @@ class TwinPlant {
     t->est_index = static_cast<std::uint8_t>(j);
     t->est_eta = 1.0 - static_cast<double>(est_.loss(j));
     t->est_sd = static_cast<double>(est_.loss_sd(j));
+    t->est_stat = j < n ? static_cast<double>(est_.evidence(j)) : 0.0;
+    t->stat_threshold = static_cast<double>(est_.evidence_threshold());
     t->alarm_story = static_cast<std::uint8_t>(est_.alarm_story());
+    t->second_story = static_cast<std::uint8_t>(est_.second_story());
+    t->damage_size = static_cast<double>(est_.damage_size());
+    t->second_size = static_cast<double>(est_.second_size());
+    t->onset_s = est_.onset_step() < 0 ? -1.0 : static_cast<double>(est_.onset_step()) * est_.period();
     if (est_.detected()) t->flags |= kDamage;
     if (est_.device_alarm()) t->flags |= kDeviceAlarm;
   }

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "vines/twin/decision.hpp"
 #include "vines/twin/image_decoder.hpp"
 
 namespace vines::twin {
@@ -40,24 +41,29 @@ class Estimator : public ImageDecoder<S, N> {
       for (int i = 0; i < kP; ++i) J_[j][i] = S(0);
     }
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
-    since_ = 0;
+    since_ = 0, k_ = 0, phase_ = 0;
     impact_left_ = 0;
-    story_ = -1;
-    detected_ = false;
     device_alarm_ = false;
+    factored_ = false;
     a_ = a0;
+    dec_.init(d_.stories, decision_settings(), base_, sigma0_);
     update(y, ny);
     refresh_sd();
+    dec_.observe(k_, loss_, sd_max());
   }
 
   // One sensor period to ground acceleration a1, then the measurements y.
   void step(S a1, const double* y, int ny) {
     predict(a1);
     update(y, ny);
+    dec_.observe(++k_, loss_, sd_max());
     if (++since_ >= update_steps_) {
       since_ = 0;
       solve();
-      decide();
+      device_decide();
+      phase_ = 1;
+    } else if (phase_ > 0) {
+      decision_phase();
     }
   }
 
@@ -73,14 +79,23 @@ class Estimator : public ImageDecoder<S, N> {
   TwinParam kind(int j) const { return static_cast<TwinParam>(kind_[j]); }
   S loss_sd(int j) const { return sd_[j]; }
   S innovation(int i) const { return eps_[i]; }
-  int alarm_story() const { return detected_ ? story_ + 1 : 0; }  // 1-based, 0: none
-  bool detected() const { return detected_; }
+  // The decision (twin/decision.hpp): detected; the story (1-based; 0: none
+  // named), a second one, their sizes; the onset's step (-1: none); each
+  // story's statistic in the leading test, and the absolute test's threshold.
+  int alarm_story() const { return dec_.story(); }
+  int second_story() const { return dec_.second_story(); }
+  S damage_size() const { return dec_.size(); }
+  S second_size() const { return dec_.second_size(); }
+  long onset_step() const { return dec_.onset_step(); }
+  S evidence(int j) const { return dec_.evidence(j); }
+  S evidence_threshold() const { return dec_.threshold(); }
+  bool detected() const { return dec_.detected(); }
   bool device_alarm() const { return device_alarm_; }
 
  private:
   using Base::d_, Base::set_, Base::kind_, Base::dA_, Base::B0_, Base::B1_, Base::G_, Base::W_;
   using Base::L_, Base::Lq_, Base::C_, Base::H_, Base::top_c_, Base::top_h_, Base::prior_, Base::cap_;
-  using Base::var_, Base::update_steps_, Base::hold_steps_;
+  using Base::var_, Base::update_steps_, Base::hold_steps_, Base::base_, Base::sigma0_;
 
   // ---- filter ----------------------------------------------------------------
   static S dot(const S* a, const S* b, int n) {
@@ -168,27 +183,18 @@ class Estimator : public ImageDecoder<S, N> {
     }
   }
 
-  // Cholesky of J + prior (lower, in place of a copy); false if not positive.
+  // Cholesky of J + prior (lower); false if not positive.
   bool factor(S (&F)[kP][kP]) const {
-    const int np = d_.np;
-    for (int a = 0; a < np; ++a)
-      for (int b = 0; b <= a; ++b) {
-        S t = J_[a][b] + (a == b ? prior_[a] : S(0));
-        for (int c = 0; c < b; ++c) t -= F[a][c] * F[b][c];
-        if (a == b) {
-          if (!(t > S(0))) return false;
-          F[a][a] = std::sqrt(t);
-        } else {
-          F[a][b] = t / F[b][b];
-        }
-      }
-    return true;
+    for (int a = 0; a < d_.np; ++a)
+      for (int b = 0; b <= a; ++b) F[a][b] = J_[a][b] + (a == b ? prior_[a] : S(0));
+    return cholesky(F, d_.np);
   }
   // Gauss-Newton step on the losses from the gradient since the last one.
   void solve() {
     const int np = d_.np;
-    S F[kP][kP];
-    if (!factor(F)) return;
+    factored_ = factor(F_);
+    if (!factored_) return;
+    const S(&F)[kP][kP] = F_;
     S u[kP];
     for (int a = 0; a < np; ++a) {
       S t = g_[a];
@@ -242,41 +248,55 @@ class Estimator : public ImageDecoder<S, N> {
     }
   }
 
-  // The decision: a story whose loss is beyond kappa sd and the smallest
-  // size, held for the hold time, raises the alarm (latched); the story
-  // reported is the strongest candidate (largest loss over its threshold).
-  // The TMD's spring: the same on |loss| with its own size. Masses: none.
-  // A plausibility gate: a story does not gain stiffness in an earthquake,
-  // so a story whose estimated gain is at least a candidate's loss says the
-  // data do not support the split of the estimates (a narrow-band record
-  // exciting one mode, a model error): the candidate waits.
-  void decide() {
-    const S kappa = static_cast<S>(set_[kKappa]);
-    auto threshold = [&](int j, bool tmd) {
-      const S floor = static_cast<S>(set_[tmd ? kDeviceLossMin : kLossMin]);
-      return kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
-    };
-    S gain(0);
-    for (int j = 0; j < d_.stories; ++j) gain = -loss_[j] > gain ? -loss_[j] : gain;
-    int best = -1;
-    S best_ratio(0);
+  // The TMD spring's alarm: |loss| beyond kappa sd and its smallest size,
+  // held for the hold time (latched).
+  void device_decide() {
     for (int j = 0; j < d_.np; ++j) {
-      if (kind_[j] == static_cast<std::uint8_t>(TwinParam::kMass)) continue;
-      const bool tmd = kind_[j] == static_cast<std::uint8_t>(TwinParam::kDeviceSpring);
-      const S size = tmd ? (loss_[j] < S(0) ? -loss_[j] : loss_[j]) : loss_[j];
-      const S thr = threshold(j, tmd);
-      const bool candidate = size > thr && (tmd || size > gain);
-      held_[j] = candidate ? held_[j] + update_steps_ : 0;
-      if (tmd) {
-        if (held_[j] >= hold_steps_) device_alarm_ = true;
-        continue;
-      }
-      if (held_[j] >= hold_steps_ && (best < 0 || size / thr > best_ratio)) best = j, best_ratio = size / thr;
+      if (kind_[j] != static_cast<std::uint8_t>(TwinParam::kDeviceSpring)) continue;
+      const S kappa = static_cast<S>(set_[kKappa]), floor = static_cast<S>(set_[kDeviceLossMin]);
+      const S thr = kappa * sd_[j] > floor ? kappa * sd_[j] : floor;
+      const S size = loss_[j] < S(0) ? -loss_[j] : loss_[j];
+      held_[j] = size > thr ? held_[j] + update_steps_ : 0;
+      if (held_[j] >= hold_steps_) device_alarm_ = true;
     }
-    if (best >= 0) {
-      detected_ = true;
-      story_ = best;
+  }
+
+  // The stories' decision (twin/decision.hpp), one part a step after an
+  // update so that no step carries it all: the estimate's covariance of the
+  // stories (the stories' block of (J + prior)^-1: the device's parameter
+  // marginalised), the absolute test, one change test, the verdict.
+  void decision_phase() {
+    const int n = d_.stories;
+    if (phase_ == 1) {
+      S P[kP][kP];
+      inverse_from_factor(F_, d_.np, P);
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) sig_[a][b] = P[a][b];
+    } else if (phase_ == 2) {
+      dec_.absolute(loss_, sig_);
+    } else if (phase_ == 3) {
+      dec_.change(loss_, sig_, sd_max());
+    } else if (phase_ == 4) {
+      dec_.decide(update_steps_);
     }
+    phase_ = phase_ >= 4 || !factored_ ? 0 : phase_ + 1;
+  }
+  S sd_max() const {
+    S m(0);
+    for (int j = 0; j < d_.stories; ++j) m = sd_[j] > m ? sd_[j] : m;
+    return m;
+  }
+  DecisionSettings<S> decision_settings() const {
+    DecisionSettings<S> c;
+    c.threshold = static_cast<S>(set_[kThreshold]);
+    c.threshold_change = static_cast<S>(set_[kThresholdChange]);
+    c.two = static_cast<S>(set_[kTwoStory]);
+    c.separation = static_cast<S>(set_[kSeparation]);
+    c.inflation = static_cast<S>(set_[kInflation]);
+    c.drift_var = static_cast<S>(set_[kDriftVar]);
+    c.snap_steps = static_cast<long>(set_[kSnapSteps]);
+    c.hold_steps = hold_steps_;
+    return c;
   }
 
   // state
@@ -284,9 +304,11 @@ class Estimator : public ImageDecoder<S, N> {
   S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
   S r2_[kY] = {}, eps_[kY] = {};
   long held_[kP] = {};
-  long since_ = 0, impact_left_ = 0;
-  int story_ = -1;
-  bool detected_ = false, device_alarm_ = false;
+  long since_ = 0, impact_left_ = 0, k_ = 0;
+  bool device_alarm_ = false, factored_ = false;
+  int phase_ = 0;
+  S F_[kP][kP] = {}, sig_[N][N] = {};  // the last factor of J + prior; the stories' covariance
+  Decision<S, N> dec_;
 };
 
 }  // namespace vines::twin

@@ -11,7 +11,8 @@
 //   f64 settings[kTwinSettings] (TwinSetting order),
 //   f64 dA[nx][nx], B0[nx], B1[nx], G[np][nx], W[np][nx], L[nx][ny],
 //   Lq[nx][ny], C[ny][nx], H[ny][np], top_c[nx], top_h[np],
-//   prior_info[np], step_cap[np], innovation_var[ny]
+//   prior_info[np], step_cap[np], innovation_var[ny],
+//   base[stories], sigma0[stories][stories]
 // (L the gain with the device's force free, Lq with it held near zero: the
 // same but for a VI NES; W_j the state's row that parameter j's force is
 // proportional to; innovation_var the quiet design's)
@@ -33,7 +34,7 @@ inline constexpr int kMaxSensors = 8;
 inline constexpr std::uint8_t kNone8 = 255;  // "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
-inline constexpr std::uint16_t kTwinVersion = 2;
+inline constexpr std::uint16_t kTwinVersion = 3;
 
 // The state beyond the frame's 2N: none (bare frame), the device's force on
 // its floor as an unknown input (VI NES: one state), or the TMD's own mass
@@ -51,9 +52,9 @@ enum class TwinParam : std::uint8_t {
 enum TwinSetting : int {
   kForget,        // information kept per step (exp(-h / memory))
   kUpdateSteps,   // steps between parameter updates
-  kKappa,         // a loss is a candidate beyond kappa standard deviations...
-  kLossMin,       // ...and beyond this size (stories)
-  kDeviceLossMin, // the TMD spring's candidate size (|loss|)
+  kKappa,         // the TMD spring is a candidate beyond kappa standard deviations...
+  kThreshold,     // a story: one-story statistic of the absolute test (twin/decision.hpp)
+  kDeviceLossMin, // ...and beyond this size (|loss|)
   kHoldSteps,     // a candidate held this long is an alarm
   kInnovAlpha,    // weight of a step in the innovations' running mean square
   kForceScale,    // device force state to N (the device floor's mass)
@@ -62,6 +63,12 @@ enum TwinSetting : int {
   kPeriod,        // h [s]
   kJumpSigma,     // an innovation beyond this many quiet sd: the impact gain...
   kJumpHold,      // ...for this many steps
+  kThresholdChange,  // one-story statistic of a change test
+  kTwoStory,      // two stories: the pair's statistic beyond the best story's by this
+  kSeparation,    // a story named: its statistic beyond the next story's by this
+  kInflation,     // the estimate's covariance times this in the tests
+  kDriftVar,      // a change test's model drift, variance per story
+  kSnapSteps,     // steps between the decision's snapshots
   kTwinSettings
 };
 
@@ -88,7 +95,8 @@ inline std::size_t twin_header_bytes(const TwinDims& d) {
 }
 inline std::size_t twin_values(const TwinDims& d) {
   const std::size_t x = d.nx, p = d.np, y = d.ny;
-  return kTwinSettings + x * x + 2 * x + 2 * p * x + 3 * x * y + y * p + x + 3 * p + y;
+  const std::size_t n = d.stories;
+  return kTwinSettings + x * x + 2 * x + 2 * p * x + 3 * x * y + y * p + x + 3 * p + y + n + n * n;
 }
 inline bool is_twin_image(const std::uint8_t* p, std::size_t n) {
   return p != nullptr && n >= 4 && std::memcmp(p, kTwinMagic, 4) == 0;

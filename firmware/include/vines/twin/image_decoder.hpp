@@ -100,7 +100,7 @@ class ImageDecoder {
   }
   // The v-th value after the header, into its place.
   void put(std::size_t v, double x) {
-    const std::size_t nx = d_.nx, np = d_.np, ny = d_.ny;
+    const std::size_t nx = d_.nx, np = d_.np, ny = d_.ny, n = d_.stories;
     const S s = static_cast<S>(x);
     std::size_t o = kTwinSettings;
     if (v < o) {
@@ -125,7 +125,9 @@ class ImageDecoder {
     else if (in(np)) top_h_[v - o] = s;
     else if (in(np)) prior_[v - o] = s;
     else if (in(np)) cap_[v - o] = s;
-    else var_[v - o] = s;
+    else if (in(ny)) var_[v - o] = s;
+    else if (in(n)) base_[v - o] = s;
+    else sigma0_[(v - o) / n][(v - o) % n] = s;
   }
   // The decoded image's indices and settings make sense for this node.
   const char* check() {
@@ -137,10 +139,19 @@ class ImageDecoder {
     if (d_.extra == TwinExtra::kForce && device_dof_ >= d_.stories) return "twin image: the device floor is off the frame";
     const double* c = set_;
     if (!(c[kForget] > 0 && c[kForget] <= 1) || !(c[kUpdateSteps] >= 1 && c[kUpdateSteps] <= 1e6) ||
-        !(c[kKappa] >= 0) || !(c[kLossMin] >= 0) || !(c[kDeviceLossMin] >= 0) || !(c[kHoldSteps] >= 0) ||
+        !(c[kKappa] >= 0) || !(c[kThreshold] > 0) || !(c[kDeviceLossMin] >= 0) || !(c[kHoldSteps] >= 0) ||
         !(c[kInnovAlpha] > 0 && c[kInnovAlpha] <= 1) || !(c[kLossLow] < 0 && c[kLossHigh] > 0 && c[kLossHigh] < 1) ||
-        !(c[kPeriod] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0))
+        !(c[kPeriod] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0) || !(c[kThresholdChange] > 0) ||
+        !(c[kTwoStory] >= 0) || !(c[kSeparation] >= 0) || !(c[kInflation] > 0) || !(c[kDriftVar] >= 0) ||
+        !(c[kSnapSteps] >= 1 && c[kSnapSteps] <= 1e6))
       return "twin image: a setting out of range";
+    // The model's covariance: symmetric with a positive diagonal (the tests
+    // add it to a positive definite one).
+    for (int a = 0; a < d_.stories; ++a) {
+      if (!(sigma0_[a][a] >= S(0))) return "twin image: the model's covariance has a negative variance";
+      for (int b = 0; b < a; ++b)
+        if (!(sigma0_[a][b] == sigma0_[b][a])) return "twin image: the model's covariance is not symmetric";
+    }
     for (int i = 0; i < d_.ny; ++i)
       if (!(var_[i] > S(0))) return "twin image: an innovation variance is not positive";
     update_steps_ = static_cast<long>(c[kUpdateSteps]);
@@ -160,6 +171,7 @@ class ImageDecoder {
   S dA_[kX][kX] = {}, B0_[kX] = {}, B1_[kX] = {}, G_[kP][kX] = {}, W_[kP][kX] = {};
   S L_[kX][kY] = {}, Lq_[kX][kY] = {}, C_[kY][kX] = {};
   S H_[kY][kP] = {}, top_c_[kX] = {}, top_h_[kP] = {}, prior_[kP] = {}, cap_[kP] = {}, var_[kY] = {};
+  S base_[N] = {}, sigma0_[N][N] = {};
   long update_steps_ = 1, hold_steps_ = 0;
 };
 
