@@ -4,11 +4,13 @@
 // against a run without [damage] when nothing changes, and by the energy
 // balance across the switch.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -233,18 +235,22 @@ TEST(Damage, Refusals) {
   }
   s.duration_s = 0;
   s.damage.time_s = 60.0;  // El Centro: 53.74 s
-  EXPECT_THROW(run_scene(s, RunOptions{}), SceneError);
+  RunOptions to_dir;
+  to_dir.out_dir = (std::filesystem::temp_directory_path() / ("vines_damage_" + std::to_string(::getpid()))).string();
+  EXPECT_THROW(run_scene(s, to_dir), SceneError);
+  EXPECT_FALSE(std::filesystem::exists(to_dir.out_dir));  // refused before the folder is claimed
 
   Scene f = load_scene(scene_path("elcentro_vines_fixed.toml"));
   f.duration_s = 2.0;
   f.damage.time_s = 1.0;
   f.damage.stiffness_scales.assign(10, 0.9);
   try {
-    run_scene(f, RunOptions{});
+    run_scene(f, to_dir);
     ADD_FAILURE() << "accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not available in fixed point"), std::string::npos) << e.what();
   }
+  EXPECT_FALSE(std::filesystem::exists(to_dir.out_dir));
   f.damage.stiffness_scales.assign(10, 1.0);
   EXPECT_NO_THROW(run_scene(f, RunOptions{}));
 }

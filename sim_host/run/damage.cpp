@@ -15,14 +15,18 @@ std::size_t damage_sample(double time_s, double rate_hz) {
   return k > 0 ? static_cast<std::size_t>(k) : 0;
 }
 
+void check_damage_scalar(const DamageSpec& damage, Scalar scalar, const std::string& what) {
+  if (damage.any() && scalar == Scalar::kFixed)
+    throw std::runtime_error(what + ": [damage]: a change of model mid-run is not available in fixed point "
+                             "(loop.scalar = \"fixed\"): run the scene in double or float");
+}
+
 DamagedRun::DamagedRun(const SceneParams& p, const DamageSpec& damage, Scalar scalar, double rate_hz,
                        const std::string& what)
     : what_(what) {
   before_ = build_engine(p, scalar, what);
   if (!damage.any()) return;
-  if (scalar == Scalar::kFixed)
-    throw std::runtime_error(what + ": [damage]: a change of model mid-run is not available in fixed point "
-                             "(loop.scalar = \"fixed\"): run the scene in double or float");
+  check_damage_scalar(damage, scalar, what);
   after_ = build_engine(damaged_params(p, damage), scalar, what + " (damaged at damage.time_s)");
   switch_k_ = damage_sample(damage.time_s, rate_hz);
 }

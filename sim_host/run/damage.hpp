@@ -48,4 +48,8 @@ class DamagedRun {
 // The sample at which damage at time_s strikes: the first at or after it.
 std::size_t damage_sample(double time_s, double rate_hz);
 
+// Refuses (std::runtime_error naming `what`) damage that changes a story in
+// a scalar with no change of model mid-run (fixed point).
+void check_damage_scalar(const DamageSpec& damage, Scalar scalar, const std::string& what);
+
 }  // namespace vines::host

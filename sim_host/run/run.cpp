@@ -249,6 +249,11 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
                         ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz))
                         : 0;
 
+  // A [damage] the run cannot take (after the record's end, in fixed point):
+  // refused before anything is written, not ignored.
+  check_damage_time(scene, static_cast<double>(ex.samples.size() - 1) / ex.rate_hz);
+  check_damage_scalar(scene.damage, scene.scalar, scene.path);
+
   // The run's folder, claimed (and locked) before the run: its marker keeps
   // what the results come from, the scene's and the record's bytes.
   std::optional<OutputDir> out;
@@ -260,9 +265,6 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
     out.emplace(opt.out_dir, "vines run", std::vector<std::string>{"summary.json", "timeseries.csv", "timeseries.npy"},
                 d.hex());
   }
-
-  // A [damage] that would strike after the record: refused, not ignored.
-  check_damage_time(scene, static_cast<double>(ex.samples.size() - 1) / ex.rate_hz);
 
   // The device run, and with a device the bare frame on the same samples.
   const int width = series ? static_cast<int>(timeseries_columns(scene, p.frame.stories, false).size()) : 0;
