@@ -26,7 +26,11 @@ void print_twin(const host::HilTwinReport& t) {
   if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
   std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
   if (t.estimator == "none") return;
-  if (t.detected && t.story && t.size)
+  if (t.truth_damage_time_s) std::printf("    the truth's damage strikes at %.3f s\n", *t.truth_damage_time_s);
+  if (t.detected && t.story && t.size && t.truth_damage_time_s)
+    std::printf("    DAMAGE: story %d, loss %.1f %% at %.2f s (%.2f s after the truth's damage at %.2f s)\n", *t.story,
+                100 * *t.size, *t.detect_time_s, *t.detect_delay_s, *t.truth_damage_time_s);
+  else if (t.detected && t.story && t.size)
     std::printf("    DAMAGE: story %d, loss %.1f %% at %.2f s (%.2f s after strong motion starts at %.2f s)\n", *t.story,
                 100 * *t.size, *t.detect_time_s, *t.detect_delay_s, t.strong_motion_start_s);
   else

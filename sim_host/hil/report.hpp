@@ -80,11 +80,15 @@ struct HilTwinDevice {
 struct HilTwinReport {
   std::string estimator = "kalman";
   std::string truth;                       // the truth's scene ("" : the node's own)
-  std::vector<double> truth_story_scales;  // each story's stiffness factor in the truth
+  std::vector<double> truth_story_scales;  // each story's stiffness factor in the truth (before its damage)
+  std::optional<double> truth_damage_time_s;       // when the truth's [damage] struck (none: no [damage])
+  std::vector<double> truth_damaged_story_scales;  // each story's factor after it (truth_story_scales without)
   std::vector<int> sensors;
   std::vector<double> noise_sd_mps2;
   bool detected = false;
   std::optional<int> story;                // 1-based
+  // detect_delay_s: from truth_damage_time_s when the truth has one, else
+  // from strong_motion_start_s.
   std::optional<double> size, detect_time_s, detect_delay_s;
   double strong_motion_start_s = 0;
   std::vector<double> eta_k, eta_k_sd;     // at the end, per story
