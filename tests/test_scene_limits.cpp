@@ -120,7 +120,7 @@ std::string readme_block() {
 // is written in the example, as a key or a commented key.
 TEST(SceneReadme, ListsEveryKey) {
   const std::string block = readme_block();
-  for (const char* table : {"scene", "frame", "device", "tmd", "vines", "record", "loop", "output"}) {
+  for (const char* table : {"scene", "frame", "device", "tmd", "vines", "record", "loop", "output", "damage"}) {
     const std::string record = std::string(table) == "record" ? "" : "[record]\npath = \"a\"\n";
     const std::string msg = error_of("[" + std::string(table) + "]\nzz_unknown = 1\n" + record);
     const auto at = msg.find("(known: ");

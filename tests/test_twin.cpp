@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,49 @@ TEST(Twin, FindsAStoryLossInTheBareFrame) {
   EXPECT_NEAR(*t.size, 0.10, 0.02);
   EXPECT_LT(*t.detect_delay_s, 20.0);
   EXPECT_NEAR(t.truth_story_scales[2], 0.9, 1e-12);
+}
+
+// A truth whose story 3 loses 10 % 5 s into the record: the bench's truth
+// switches there; the report says when, the factors before and after, and
+// counts the detection's delay from the damage (not from strong motion).
+TEST(Twin, DamageDuringTheRecord) {
+  HilOptions o = twin(30.0);
+  o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_bare_story3_damage_at5.toml";
+  Scene sc = load_scene(scene_path("elcentro_bare.toml"));
+  sc.duration_s = 30.0;
+  const TwinBench tb = make_twin_bench(sc, o, load_excitation(sc, ""));
+  ASSERT_TRUE(tb.truth.damage_time_s);
+  EXPECT_EQ(*tb.truth.damage_time_s, 5.0);
+  EXPECT_EQ(tb.truth.story_scale[2], 1.0);
+  EXPECT_EQ(tb.truth.damaged_story_scale[2], 0.9);
+  EXPECT_EQ(tb.truth.damaged_story_scale[3], 1.0);
+  EXPECT_EQ(tb.delay_origin_s(), 5.0);
+  EXPECT_LT(tb.strong_motion_start_s, 5.0);
+  // Without [damage]: no time, the same factors after, the delay from strong motion.
+  HilOptions plain = o;
+  plain.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_bare_story3_loss10.toml";
+  const TwinBench tp = make_twin_bench(sc, plain, load_excitation(sc, ""));
+  EXPECT_FALSE(tp.truth.damage_time_s);
+  EXPECT_EQ(tp.truth.damaged_story_scale, tp.truth.story_scale);
+  EXPECT_EQ(tp.delay_origin_s(), tp.strong_motion_start_s);
+
+  const HilReport r = run_hil(load_scene(scene_path("elcentro_bare.toml")), o);
+  ASSERT_TRUE(r.twin);
+  const HilTwinReport& t = *r.twin;
+  const nlohmann::json j = to_json(r)["twin"];
+  SCOPED_TRACE(j.dump());
+  EXPECT_EQ(j["truth_damage_time_s"], 5.0);
+  EXPECT_EQ(j["truth_story_scales"][2], 1.0);
+  EXPECT_EQ(j["truth_damaged_story_scales"][2], 0.9);
+  ASSERT_TRUE(t.detected && t.story && t.size && t.detect_time_s && t.detect_delay_s);
+  EXPECT_GT(*t.detect_time_s, 5.0);
+  EXPECT_DOUBLE_EQ(*t.detect_delay_s, *t.detect_time_s - 5.0);
+  std::printf("damage at 5 s: story %d, loss %.3f, detected at %.3f s, delay %.3f s\n", *t.story, *t.size,
+              *t.detect_time_s, *t.detect_delay_s);
+  // Undamaged truth: null in the report, the damaged factors the same.
+  const nlohmann::json u = to_json(run_hil(load_scene(scene_path("elcentro_bare.toml")), twin(1.0)))["twin"];
+  EXPECT_TRUE(u["truth_damage_time_s"].is_null());
+  EXPECT_EQ(u["truth_damaged_story_scales"], u["truth_story_scales"]);
 }
 
 // The VI NES building, its sphere started elsewhere than the model's and
@@ -228,6 +272,24 @@ TEST(Twin, BadInputsRefused) {
   replay.node_command = VINES_EXE;
   replay.sensors = {3};
   refused(replay, "--sensors: a twin option");
+  // A truth's damage after the run's end (1 s here); damage in the node's scene.
+  o = twin(1.0);
+  o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_bare_story3_damage_at5.toml";
+  refused(o, "damage.time_s: 5 s is not inside the record as run (1 s, record.duration_s)");
+  Scene damaged = sc;
+  damaged.damage.time_s = 0.5;
+  damaged.damage.stiffness_scales.assign(10, 0.9);
+  for (HilMode mode : {HilMode::kTwin, HilMode::kReplay}) {
+    HilOptions d = twin(1.0);
+    d.mode = mode;
+    if (mode != HilMode::kTwin) d.sensors.clear(), d.measure_noise_pct = 0;
+    try {
+      run_hil(damaged, d);
+      ADD_FAILURE() << "accepted a node scene with [damage]";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("[damage]"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

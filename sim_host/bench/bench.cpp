@@ -73,6 +73,7 @@ BenchLine firmware_line(const Scene& base, const FirmwareSetting& set, const Tru
   l.scheme = scheme_name(cs);
   l.budget = cs == ContactScheme::kAdaptive ? 0 : budget;
   const auto b0 = std::chrono::steady_clock::now();
+  refuse_damage(scene, "vines bench");
   std::unique_ptr<Engine> eng = build_engine(scene.params, scalar, scene.path);
   l.build_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
 

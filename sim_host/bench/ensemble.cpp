@@ -207,6 +207,7 @@ std::vector<EnsembleMember> ensemble_members(const Scene& scene, int n) {
     throw std::runtime_error("--ensemble: " + scene.path + " has no VI NES (the ensemble varies the sphere and the record)");
   if (n < 2) throw std::runtime_error("--ensemble: needs 2 members or more, got " + std::to_string(n));
   // The scene's design (free travel, law calibration) and its bare frame's peak top-floor speed.
+  refuse_damage(scene, "vines bench --ensemble");
   const std::unique_ptr<Engine> eng = build_engine(scene.params, Scalar::kDouble, scene.path);
   const VinesDesign design = eng->info().vines;
   const Excitation ex = load_excitation(scene, "");

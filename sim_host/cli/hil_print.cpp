@@ -26,13 +26,17 @@ void print_twin(const host::HilTwinReport& t) {
   if (t.first_residual_alarm_s) std::printf(" from %.2f s", *t.first_residual_alarm_s);
   std::printf(", drift alarm %lld steps\n", t.drift_alarm_steps);
   if (t.estimator == "none") return;
+  if (t.truth_damage_time_s) std::printf("    the truth's damage strikes at %.3f s\n", *t.truth_damage_time_s);
   if (t.detected) {
     std::printf("    DAMAGE:");
     if (!t.story_identified) std::printf(" story not identified, loss about %.1f %%", 100 * t.size.value_or(0));
     for (std::size_t i = 0; i < t.stories.size(); ++i)
       std::printf("%s story %d, loss %.1f %%", i ? "," : "", t.stories[i], 100 * t.sizes[i]);
-    std::printf(" at %.2f s (%.2f s after strong motion starts at %.2f s)", *t.detect_time_s, *t.detect_delay_s,
-                t.strong_motion_start_s);
+    if (t.truth_damage_time_s)
+      std::printf(" at %.2f s (%.2f s after the truth's damage)", *t.detect_time_s, *t.detect_delay_s);
+    else
+      std::printf(" at %.2f s (%.2f s after strong motion starts at %.2f s)", *t.detect_time_s, *t.detect_delay_s,
+                  t.strong_motion_start_s);
     if (t.onset_s) std::printf("; onset %.1f s", *t.onset_s);
     std::printf("\n");
   } else {

@@ -72,6 +72,18 @@ int run(RunArgs a) {
   if (!opt.quiet) {
     std::printf("scene %s: %s, %d stories, %s, %.0f Hz\n", scene.name.c_str(), device_name(p.device.kind),
                 r.info.stories, scalar_name(r.scalar), p.loop.sensor_rate_hz);
+    if (r.damage.present()) {
+      std::string scales;
+      char one[64];
+      for (std::size_t i = 0; i < r.damage.stiffness_scales.size(); ++i)
+        if (r.damage.stiffness_scales[i] != 1.0) {
+          std::snprintf(one, sizeof one, "%sstory %zu x %g", scales.empty() ? "" : ", ", i + 1,
+                        r.damage.stiffness_scales[i]);
+          scales += one;
+        }
+      std::printf("  damage at t = %.3f s: %s\n", r.damage_switch_s,
+                  scales.empty() ? "every factor 1 (no change)" : scales.c_str());
+    }
     std::printf("  peak top displacement %.6f m at t = %.3f s\n", r.totals.peak_top, r.totals.t_peak_top);
     if (r.bare)
       std::printf("  x_r = %.2f %%   E_r = %.2f %%   (bare peak %.6f m)\n", 100 * r.x_r(), 100 * r.E_r(),

@@ -133,6 +133,15 @@ class Engine {
   // (Ledger::initial). Empty on success, else why it was refused (naming the
   // field; the state is then untouched). Not in fixed point (refused).
   virtual std::string set_physical(const PhysicalState& s) = 0;
+  // Takes over `from`'s run at a change of model (damage striking mid-run):
+  // `from` an engine of the same scalar, story count and device whose model
+  // differs in the frame alone. The loop state becomes from's (clock, sample,
+  // peaks, counters, ledger, E_e so far, the VI NES particle and its contact
+  // as they are), the linear state the same floors (x, v) and device in this
+  // model's coordinates; with the ledger, this model's stored energy less
+  // from's counts as energy put in (Ledger::initial). Empty on success, else
+  // why not (the state then untouched). Not in fixed point (refused).
+  virtual std::string take_over(const Engine& from) = 0;
 };
 
 // The engine for a scene's story count, device and law, or nullptr if this

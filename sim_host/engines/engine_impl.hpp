@@ -154,25 +154,8 @@ class EngineImpl final : public Engine {
     const M& m = *model_;
     constexpr int P = M::kP;
     typename M::VecX z = data_->z;
-    const auto solve = [&](const FloorArray& f, const char* name, int at) -> std::string {
-      int given = 0;
-      for (int i = 0; i < N; ++i) given += std::isnan(f[i]) ? 0 : 1;
-      if (given == 0) return {};
-      Eigen::Matrix<double, N, 1> b;
-      for (int i = 0; i < N; ++i) {
-        if (std::isnan(f[i]))
-          return std::string(name) + ": give all " + std::to_string(N) + " floors or none (floor " +
-                 std::to_string(i + 1) + " is NaN, " + std::to_string(given) + " are not)";
-        if (!std::isfinite(f[i])) return std::string(name) + ": floor " + std::to_string(i + 1) + " is not finite";
-        b(i) = f[i];
-      }
-      const Eigen::Matrix<double, N, N> map = m.pos_map.template leftCols<N>().template cast<double>();
-      const Eigen::PartialPivLU<Eigen::Matrix<double, N, N>> lu(map);
-      z.template segment<N>(at) = lu.solve(b).template cast<S>();
-      return {};
-    };
-    std::string why = solve(ps.x, "x", 0);
-    if (why.empty()) why = solve(ps.v, "v", P);
+    std::string why = solve_floors(ps.x, "x", 0, &z);
+    if (why.empty()) why = solve_floors(ps.v, "v", P, &z);
     if (!why.empty()) return why;
     // One of the device's quantities into *to, if given.
     const auto take = [&](double value, const char* name, bool has, S* to, double offset = 0) -> std::string {
@@ -210,7 +193,68 @@ class EngineImpl final : public Engine {
     return refused ? refused : std::string();
   }
 
+  // The data block of `from` (same engine, another model), then the floors
+  // it holds solved for this model's coordinates (a TMD's physical form: the
+  // same z), E_e's open run closed as `from` reads it, the ledger's jump.
+  std::string take_over(const Engine& from) override {
+    const std::vector<std::uint8_t> st = from.state();
+    std::string why = loop_state::check(header(), st.data(), st.size(), true);
+    if (!why.empty()) return "cannot take over the run: " + why;
+    const ModelInfo mine = info(), theirs = from.info();
+    if (theirs.sensor_period != mine.sensor_period || theirs.device_floor != mine.device_floor ||
+        theirs.tmd.mass != mine.tmd.mass || theirs.tmd.k != mine.tmd.k || theirs.tmd.c != mine.tmd.c ||
+        theirs.vines.mass != mine.vines.mass || theirs.vines.gap != mine.vines.gap)
+      return "cannot take over the run: the models differ in more than the frame (sensor period or device)";
+    const M& m = *model_;
+    auto d = std::make_unique<D>();
+    loop_state::read(st.data(), std::array<loop_state::Slot, 1>{{{d.get(), sizeof(D)}}});
+    const Snapshot now = from.snapshot();
+    typename M::VecX z = d->z;
+    why = solve_floors(now.x, "x", 0, &z);
+    if (why.empty()) why = solve_floors(now.v, "v", M::kP, &z);
+    if (!why.empty()) return "cannot take over the run: " + why;
+    if (!z.allFinite()) return "cannot take over the run: the state is not finite";
+    // E_e so far, closed on from's model (its open run ends here).
+    const double ee = now.elastic_energy;
+    d->ee_sum = {};
+    d->ee_sum.add(static_cast<S>(ee));
+    d->ee_sum.add(static_cast<S>(ee - static_cast<double>(static_cast<S>(ee))));
+    d->ee_open = false;
+    const bool ledger = m.loop.energy_ledger;
+    const S before = d->ledger.kinetic + d->ledger.strain + d->ledger.device;  // from's, closed by its last step
+    d->z = z;
+    vines::detail::refresh_floors(m, *d);
+    d->last_strain = m.strain.eval(d->z, S(0));
+    if (ledger) {
+      d->ledger.initial += vines::detail::stored_energy(m, *d) - before;
+      vines::detail::close_ledger(m, *d);
+    }
+    data_ = std::move(d);
+    return {};
+  }
+
  private:
+  // Floors f (NaN: all or none) solved for the position (velocity)
+  // coordinates z[at..at+N) in double: pos_map's first N columns (the mode
+  // shapes in modal form, the identity in the TMD's physical form), LU.
+  std::string solve_floors(const FloorArray& f, const char* name, int at, typename M::VecX* z) const {
+    int given = 0;
+    for (int i = 0; i < N; ++i) given += std::isnan(f[i]) ? 0 : 1;
+    if (given == 0) return {};
+    Eigen::Matrix<double, N, 1> b;
+    for (int i = 0; i < N; ++i) {
+      if (std::isnan(f[i]))
+        return std::string(name) + ": give all " + std::to_string(N) + " floors or none (floor " +
+               std::to_string(i + 1) + " is NaN, " + std::to_string(given) + " are not)";
+      if (!std::isfinite(f[i])) return std::string(name) + ": floor " + std::to_string(i + 1) + " is not finite";
+      b(i) = f[i];
+    }
+    const Eigen::Matrix<double, N, N> map = model_->pos_map.template leftCols<N>().template cast<double>();
+    const Eigen::PartialPivLU<Eigen::Matrix<double, N, N>> lu(map);
+    z->template segment<N>(at) = lu.solve(b).template cast<S>();
+    return {};
+  }
+
   std::array<loop_state::Slot, 1> slots() const { return {{{data_.get(), sizeof(D)}}}; }
   loop_state::Header header() const {
     return loop_state::header_of<N, Dev>(kScalar, sizeof(D), fingerprint_.of(*this));

@@ -196,6 +196,10 @@ class FixedEngine final : public Engine {
     return "set_physical: not available in fixed point (loop.scalar = \"fixed\"); state() and load_state() are: "
            "run the scene in double or float to set a physical state";
   }
+  std::string take_over(const Engine&) override {
+    return "a change of model mid-run (a [damage] table) is not available in fixed point (loop.scalar = "
+           "\"fixed\"): run the scene in double or float";
+  }
 
  private:
   static constexpr std::size_t kStateBytes = sizeof(FD) + sizeof(Counters) + sizeof(fixed::SampleHold) +

@@ -123,8 +123,9 @@ void read(const std::uint8_t* p, const Slots& slots) {
 }
 
 // Empty if p[0..n) is a state with header `want` (this engine's), else why
-// not; the blocks then start at p + sizeof(Header).
-inline std::string check(const Header& want, const std::uint8_t* p, std::size_t n) {
+// not; the blocks then start at p + sizeof(Header). With any_model, a state
+// of another model of the same engine is accepted (Engine::take_over).
+inline std::string check(const Header& want, const std::uint8_t* p, std::size_t n, bool any_model = false) {
   const std::size_t total = sizeof(Header) + want.block_bytes;
   if (n < sizeof kMagic) return n && std::memcmp(p, kMagic, n) == 0 ? "truncated" : "not a vines loop state";
   if (std::memcmp(p, kMagic, sizeof kMagic) != 0) return "not a vines loop state";
@@ -141,7 +142,7 @@ inline std::string check(const Header& want, const std::uint8_t* p, std::size_t 
   if (h.block_bytes != want.block_bytes)
     return "a state of another build (" + std::to_string(h.block_bytes) + " bytes of data; this engine's: " +
            std::to_string(want.block_bytes) + ")";
-  if (h.model != want.model) {
+  if (!any_model && h.model != want.model) {
     char why[128];
     std::snprintf(why, sizeof why, "a state of another model (fingerprint %016llx; this engine's: %016llx)",
                   static_cast<unsigned long long>(h.model), static_cast<unsigned long long>(want.model));

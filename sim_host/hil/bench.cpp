@@ -115,6 +115,8 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   b.scene = scene;
   b.opt = opt;
   if (opt.duration_s > 0) b.scene.duration_s = opt.duration_s;
+  // The node runs its scene's model: damage belongs to the twin's truth.
+  if (opt.mode != HilMode::kTwin) refuse_damage(scene, "vines hil (the node's scene)");
   choose_node(&b);
   const Scene& sc = b.scene;
   b.ex = load_excitation(sc, "");

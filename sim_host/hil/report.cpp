@@ -44,6 +44,8 @@ json to_json(const HilTwinReport& t) {
   json j = {{"estimator", t.estimator},
             {"truth", t.truth},
             {"truth_story_scales", t.truth_story_scales},
+            {"truth_damage_time_s", to_json(t.truth_damage_time_s)},
+            {"truth_damaged_story_scales", t.truth_damaged_story_scales},
             {"sensors", t.sensors},
             {"noise_sd_mps2", t.noise_sd_mps2},
             {"strong_motion_start_s", t.strong_motion_start_s}};

@@ -80,7 +80,9 @@ struct HilTwinDevice {
 struct HilTwinReport {
   std::string estimator = "kalman";
   std::string truth;                       // the truth's scene ("" : the node's own)
-  std::vector<double> truth_story_scales;  // each story's stiffness factor in the truth
+  std::vector<double> truth_story_scales;  // each story's stiffness factor in the truth (before its damage)
+  std::optional<double> truth_damage_time_s;       // when the truth's [damage] struck (none: no [damage])
+  std::vector<double> truth_damaged_story_scales;  // each story's factor after it (truth_story_scales without)
   std::vector<int> sensors;
   std::vector<double> noise_sd_mps2;
   bool detected = false;
@@ -88,6 +90,8 @@ struct HilTwinReport {
   bool story_identified = false;           // detected and a story named
   std::vector<int> stories;                // the stories named (one or two), 1-based
   std::vector<double> sizes;               // their losses
+  // detect_delay_s: from truth_damage_time_s when the truth has one, else
+  // from strong_motion_start_s.
   std::optional<double> size, detect_time_s, detect_delay_s;
   std::optional<double> onset_s;           // when the node estimates the change happened
   double strong_motion_start_s = 0;

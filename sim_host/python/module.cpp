@@ -222,6 +222,7 @@ struct PyLoop {
 
 PyLoop make_loop(const PyScene& s) {
   PyLoop l;
+  refuse_damage(s.scene, "vines.Loop");
   l.eng = build_engine(s.scene.params, s.scene.scalar, s.scene.path);
   l.stories = l.eng->info().stories;
   l.ledger = s.scene.params.loop.energy_ledger;

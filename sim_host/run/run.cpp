@@ -14,6 +14,7 @@
 #include "sim_host/io/npy.hpp"
 #include "sim_host/io/digest.hpp"
 #include "sim_host/io/output.hpp"
+#include "sim_host/run/damage.hpp"
 #include "sim_host/run/drive.hpp"
 #include "sim_host/scene/names.hpp"
 
@@ -36,7 +37,8 @@ struct Keep {
 
 struct Trace {
   RunTotals totals;
-  ModelInfo info;
+  ModelInfo info;                        // the scene's model
+  std::optional<ModelInfo> damaged_info;  // with [damage]: the model after it
   std::vector<Snapshot> rows;
   std::vector<double> values;  // rows of Keep::width
   double wall_s = 0;
@@ -59,10 +61,12 @@ void append_values(const Snapshot& s, int n, DeviceKind kind, bool bare, std::ve
 }
 
 // One engine run over the samples, keeping what `keep` asks every `every` steps.
+// With [damage], the damaged model from the sample at damage.time_s on.
 Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex, int every, const Keep& keep) {
-  std::unique_ptr<Engine> eng = build_engine(p, scene.scalar, scene.path);
+  DamagedRun eng(p, scene.damage, scene.scalar, ex.rate_hz, scene.path);
   Trace tr;
-  tr.info = eng->info();
+  tr.info = eng.undamaged().info();
+  if (const Engine* after = eng.damaged()) tr.damaged_info = after->info();
   // Every row's room at once: no copies as they grow.
   const std::size_t rows = every > 0 ? ex.samples.size() / static_cast<std::size_t>(every) + 2 : 0;
   if (keep.snapshots) tr.rows.reserve(rows);
@@ -70,13 +74,13 @@ Trace run_engine(const Scene& scene, const SceneParams& p, const Excitation& ex,
   const int n = tr.info.stories;
   const auto t0 = std::chrono::steady_clock::now();
   hal::RecordSource src(ex.samples, ex.rate_hz);
-  drive(*eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) {
-    const Snapshot s = eng->snapshot();
+  drive(eng, src, static_cast<std::size_t>(std::max(every, 0)), [&](std::size_t) {
+    const Snapshot s = eng.engine().snapshot();
     if (keep.width > 0) append_values(s, n, p.device.kind, keep.bare, &tr.values);
     if (keep.snapshots) tr.rows.push_back(s);
   });
   tr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  tr.totals = eng->totals();
+  tr.totals = eng.engine().totals();
   return tr;
 }
 
@@ -245,6 +249,11 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
                         ? static_cast<int>(std::llround(p.loop.sensor_rate_hz / scene.output.rate_hz))
                         : 0;
 
+  // A [damage] the run cannot take (after the record's end, in fixed point):
+  // refused before anything is written, not ignored.
+  check_damage_time(scene, static_cast<double>(ex.samples.size() - 1) / ex.rate_hz);
+  check_damage_scalar(scene.damage, scene.scalar, scene.path);
+
   // The run's folder, claimed (and locked) before the run: its marker keeps
   // what the results come from, the scene's and the record's bytes.
   std::optional<OutputDir> out;
@@ -274,6 +283,9 @@ RunReport run_scene(const Scene& scene, const Excitation& ex, const RunOptions& 
   r.record = {ex.record.path, ex.record.dt_s, ex.record.accel_mps2.size(), ex.record.pga_mps2(),
               static_cast<double>(ex.samples.size() - 1) / ex.rate_hz};
   r.info = dev.info;
+  r.damage = scene.damage;
+  r.damage_switch_s = static_cast<double>(damage_sample(scene.damage.time_s, ex.rate_hz)) / ex.rate_hz;
+  r.damaged_info = dev.damaged_info;
   r.totals = dev.totals;
   if (has_device) r.bare = bare.totals;
   r.wall_s = dev.wall_s;
@@ -352,6 +364,16 @@ json RunReport::to_json() const {
                    {"bad_samples_held", t.count.bad_samples},
                    {"divergences_rolled_back", t.count.divergences}};
   j["modal"] = modal_json(info);
+  // The damage that struck during the run (both runs, device and bare).
+  if (damage.present()) {
+    j["damage"] = {{"time_s", damage.time_s},
+                   {"switch_s", damage_switch_s},
+                   {"stiffness_scales", damage.stiffness_scales},
+                   {"frequency_hz_after", damaged_info ? head(damaged_info->frequency_hz, info.stories)
+                                                       : head(info.frequency_hz, info.stories)}};
+  } else {
+    j["damage"] = nullptr;
+  }
   if (bare) j["device_params"] = device_json(p.device.kind, info);
   j["wall_time_s"] = wall_s;
   // Whether the figures above can be trusted (docs/model.md, "Run status").

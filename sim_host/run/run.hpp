@@ -73,6 +73,12 @@ struct RunReport {
   std::optional<RunTotals> bare;  // with a device: the bare frame on the same record
   double wall_s = 0;              // the device run's loop
   RunStatus status;               // ok, or degraded and why (either run)
+  // The scene's [damage] (both runs switch to the damaged frame at the
+  // sample switch_s, the first at or after damage.time_s), and the damaged
+  // model's modes (none when no factor differs from 1).
+  DamageSpec damage;
+  double damage_switch_s = 0;
+  std::optional<ModelInfo> damaged_info;
   // With RunOptions::keep_series: the steps at the output rate (t = 0 first),
   // of the device run and (with a device) the bare frame.
   std::vector<Snapshot> series, bare_series;

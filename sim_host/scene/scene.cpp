@@ -32,6 +32,7 @@
 //             split_steps, scalar = "double" | "float" | "fixed",
 //             fixed_accel_mps2, fixed_amplification, fixed_contact_speed_mps
 //   [output]  rate_hz (must divide loop.sensor_rate_hz), timeseries, format (csv, npy)
+//   [damage]  time_s, stiffness_scales (both required; damage.cpp)
 //
 // Rules:
 // - Unknown tables and keys are errors; so is a value of the wrong type. An
@@ -273,7 +274,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
 // ---- the format: each table's keys ----
 namespace {
 const std::initializer_list<std::string_view> kTables = {"scene", "frame",  "device", "tmd",
-                                                         "vines", "record", "loop",   "output"};
+                                                         "vines", "record", "loop",   "output", "damage"};
 const std::initializer_list<std::string_view> kSceneKeys = {"name"};
 const std::initializer_list<std::string_view> kFrameKeys = {
     "preset", "masses_kg", "stiffnesses_n_per_m", "damping", "stiffness_damping_s", "rayleigh_zeta",
@@ -291,6 +292,7 @@ const std::initializer_list<std::string_view> kLoopKeys = {
     "floor_peaks",    "divergence_limit_m", "contact_scheme",    "bounded_substeps",      "split_steps",
     "scalar",         "fixed_accel_mps2",   "fixed_amplification", "fixed_contact_speed_mps"};
 const std::initializer_list<std::string_view> kOutputKeys = {"rate_hz", "timeseries", "format"};
+const std::initializer_list<std::string_view> kDamageKeys = {"time_s", "stiffness_scales"};
 }  // namespace
 
 bool is_scene_key(const std::string& dotted) {
@@ -299,7 +301,8 @@ bool is_scene_key(const std::string& dotted) {
   const std::string_view table(dotted.data(), dot), key(dotted.data() + dot + 1, dotted.size() - dot - 1);
   for (const auto& [name, keys] : {std::pair{"scene", kSceneKeys}, {"frame", kFrameKeys}, {"device", kDeviceKeys},
                                    {"tmd", kTmdKeys}, {"vines", kVinesKeys}, {"record", kRecordKeys},
-                                   {"loop", kLoopKeys}, {"output", kOutputKeys}})
+                                   {"loop", kLoopKeys}, {"output", kOutputKeys},
+                                   {"damage", kDamageKeys}})
     if (table == name) return std::find(keys.begin(), keys.end(), key) != keys.end();
   return false;
 }
@@ -321,9 +324,7 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
   const Section meta(origin, root, "scene", kSceneKeys);
   if (meta.read("name", &scene.name) && scene.name.empty())
     meta.fail_at("name", "must not be empty");
-  read_frame(
-      Section(origin, root, "frame", kFrameKeys),
-      &p.frame);
+  read_frame(Section(origin, root, "frame", kFrameKeys), &p.frame);
   const Section device(origin, root, "device", kDeviceKeys);
   read_device(device, &p.device);
   read_tmd(Section(origin, root, "tmd", kTmdKeys), &p.device.tmd);
@@ -354,6 +355,7 @@ Scene scene_from_table(const toml::table& root, const std::string& origin) {
   }
   read_output(Section(origin, root, "output", kOutputKeys), p.loop.sensor_rate_hz,
               &scene.output);
+  read_damage(Section(origin, root, "damage", kDamageKeys), p.frame.stories, &scene.damage);
   return scene;
 }
 
@@ -369,39 +371,5 @@ toml::table read_scene_table(const std::string& path) {
 }
 
 Scene load_scene(const std::string& path) { return scene_from_table(read_scene_table(path), path); }
-
-// ---- record search: absolute as is; else cwd, scene folder, ground motions ----
-std::string resolve_record_path(const std::string& record_path, const std::string& scene_path) {
-  if (record_path.empty()) throw SceneError(scene_path + ": record.path: empty");
-  const fs::path p(record_path);
-  std::vector<std::pair<fs::path, std::string>> tried;  // candidate, why it was tried
-  if (p.is_absolute()) {
-    tried.emplace_back(p, "absolute");
-  } else {
-    tried.emplace_back(p, "working directory");
-    const fs::path dir = fs::path(scene_path).parent_path();
-    if (!dir.empty()) tried.emplace_back(dir / p, "scene folder");
-    const char* env = std::getenv("VINES_GROUND_MOTIONS");
-    if (env != nullptr && *env != '\0') {
-      tried.emplace_back(fs::path(env) / p, "$VINES_GROUND_MOTIONS");
-    } else {
-#ifdef VINES_DEFAULT_GROUND_MOTIONS
-      tried.emplace_back(fs::path(VINES_DEFAULT_GROUND_MOTIONS) / p, "default ground motions");
-#endif
-    }
-  }
-  std::string list;
-  for (const auto& [candidate, why] : tried) {
-    std::error_code ec;
-    const fs::file_type type = fs::status(candidate, ec).type();
-    if (type == fs::file_type::regular) return fs::absolute(candidate).lexically_normal().string();
-    // A folder, a device or a FIFO by that name: refused, not searched past.
-    if (type != fs::file_type::not_found && type != fs::file_type::none)
-      throw SceneError(scene_path + ": record.path: \"" + record_path + "\": " + candidate.string() + " (" + why +
-                       ") is not a regular file (a folder, device or FIFO)");
-    list += (list.empty() ? "" : ", ") + candidate.string() + " (" + why + ")";
-  }
-  throw SceneError(scene_path + ": record.path: \"" + record_path + "\" not found; tried " + list);
-}
 
 }  // namespace vines::host

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "host/record.hpp"
 #include "sim_host/scene/scalar.hpp"
@@ -24,6 +25,22 @@ struct OutputSpec {
   TimeseriesFormat format = TimeseriesFormat::kCsv;
 };
 
+// [damage]: damage that strikes during the earthquake. Until time_s the frame
+// is the scene's; from the sample at time_s on, story i's stiffness (and with
+// stiffness-proportional damping its damping) is multiplied by
+// stiffness_scales[i] as well (bottom first, each in (0, 1]).
+struct DamageSpec {
+  double time_s = 0;                     // seconds from the record's start
+  std::vector<double> stiffness_scales;  // one per story; empty: no [damage]
+  bool present() const { return !stiffness_scales.empty(); }
+  // Whether some story loses stiffness (every factor 1: a no-op).
+  bool any() const {
+    for (double s : stiffness_scales)
+      if (s != 1.0) return true;
+    return false;
+  }
+};
+
 struct Scene {
   std::string path;       // the scene file
   std::string name;       // [scene] name, default: file stem
@@ -35,6 +52,7 @@ struct Scene {
   double target_pga_mps2 = 0.0;
   Scalar scalar = Scalar::kDouble;
   OutputSpec output;
+  DamageSpec damage;
 };
 
 // Scene files and study specs are at most 1 MiB: the largest shipped is 3 kB,
@@ -62,5 +80,21 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin);
 // ($VINES_GROUND_MOTIONS, else ../shared/data/ground_motions beside the
 // repository). Throws SceneError listing the places tried.
 std::string resolve_record_path(const std::string& record_path, const std::string& scene_path);
+
+// Parameters `p` (the scene's, or its bare frame's) after the damage
+// strikes: each story's frame.stiffness_scales times the damage's (p itself
+// without [damage]). The devices are designed on the undamaged frame, so
+// they stay the same.
+SceneParams damaged_params(SceneParams p, const DamageSpec& damage);
+
+// Refuses (SceneError naming the scene, damage.time_s, the time and the
+// record's length) a [damage] whose time_s is not inside the record as run:
+// `record_s` the seconds simulated (the record, or duration_s when set).
+// `who` names the scene in the message ("" : its path).
+void check_damage_time(const Scene& scene, double record_s, const std::string& who = "");
+
+// Refuses (SceneError) a scene with [damage] where a command does not run it
+// (`command`, e.g. "vines sweep"): vines run and the twin's truth do.
+void refuse_damage(const Scene& scene, const std::string& command);
 
 }  // namespace vines::host

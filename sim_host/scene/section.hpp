@@ -1,6 +1,6 @@
 // The reading side of scene files (scene.cpp): one top-level TOML table of a
 // scene and its typed, checked reads, with messages that name the file, the
-// line and the key. Internal to scene.cpp and scene_toml.cpp.
+// line and the key. Internal to scene.cpp and damage.cpp.
 #pragma once
 
 #include <toml++/toml.h>
@@ -195,5 +195,8 @@ class Section {
   std::string name_;
   const toml::table* table_ = nullptr;
 };
+
+// [damage] (damage.cpp): time_s and one factor in (0, 1] per story.
+void read_damage(const Section& s, int stories, DamageSpec* d);
 
 }  // namespace vines::host::scene_detail

@@ -79,6 +79,7 @@ class Cache {
   }
 
   static std::unique_ptr<Engine> build(const Scene& s, const SceneParams& p) {
+    refuse_damage(s, "vines sweep / design");
     return build_engine(p, s.scalar, s.path);
   }
   // A study run: its figures need the top floor and E_e, not every floor.

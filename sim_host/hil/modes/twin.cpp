@@ -9,6 +9,7 @@
 #include "host/record.hpp"
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/modes/twin_baseline.hpp"
+#include "sim_host/run/damage.hpp"
 #include "sim_host/run/drive.hpp"
 #include "vines/twin/image.hpp"
 
@@ -51,6 +52,7 @@ Scene truth_scene(const Scene& scene, const HilOptions& o, const Excitation& ex)
   if (tex.samples != ex.samples)
     throw std::runtime_error(who + ": its record (file, scale or pga) differs from " + scene.path +
                              "'s: the truth is the same earthquake on another building");
+  check_damage_time(t, static_cast<double>(ex.samples.size() - 1) / ex.rate_hz, who);
   return t;
 }
 
@@ -72,27 +74,36 @@ TwinBench make_twin_bench(const Scene& scene, const HilOptions& o, const Excitat
   tb.sensors = sensor_floors(o, n);
   if (o.measure_noise_mps2 > 0 && o.measure_noise_pct > 0)
     throw std::runtime_error("--measure-noise and --measure-noise-pct: give one of them");
+  if (scene.damage.present())
+    throw std::runtime_error(scene.path + ": [damage]: the node's scene is the nominal model the twin "
+                             "carries; damage goes in the measured building's scene (--truth TRUTH.toml)");
   const Scene truth = truth_scene(scene, o, ex);
   TwinTruth& tr = tb.truth;
   tr.path = o.truth_path;
-  for (int i = 0; i < n; ++i)
+  const SceneParams after = damaged_params(truth.params, truth.damage);
+  for (int i = 0; i < n; ++i) {
     tr.story_scale.push_back(truth.params.frame.stiffness_scale * truth.params.frame.stiffness_scales[i]);
+    tr.damaged_story_scale.push_back(after.frame.stiffness_scale * after.frame.stiffness_scales[i]);
+  }
+  if (truth.damage.present())
+    tr.damage_time_s = static_cast<double>(damage_sample(truth.damage.time_s, ex.rate_hz)) * h;
 
-  // The measured building, step by step: every floor's absolute acceleration.
+  // The measured building, step by step: every floor's absolute acceleration
+  // (with [damage], the damaged building from its time on).
   const std::string what = o.truth_path.empty() ? scene.path + " (truth)" : "--truth " + o.truth_path;
-  const std::unique_ptr<Engine> eng = build_engine(truth.params, Scalar::kDouble, what);
+  DamagedRun run(truth.params, truth.damage, Scalar::kDouble, ex.rate_hz, what);
   const auto K = ex.samples.size();
   std::vector<std::vector<double>> acc(K);
   const bool vines = truth.params.device.kind == DeviceKind::kVines;
   hal::RecordSource src(ex.samples, ex.rate_hz);
-  drive(*eng, src, 1, [&](std::size_t k) {
-    const Snapshot s = eng->snapshot();
+  drive(run, src, 1, [&](std::size_t k) {
+    const Snapshot s = run.engine().snapshot();
     acc[k].assign(s.acc.begin(), s.acc.begin() + n);
     tr.roof_x.push_back(s.x[static_cast<std::size_t>(n - 1)]);
     tr.device_force.push_back(vines ? -s.contact_force : 0.0);
   });
-  const ModelInfo ti = eng->info();
-  tr.contacts = eng->totals().count.contacts;
+  const ModelInfo ti = run.engine().info();
+  tr.contacts = run.engine().totals().count.contacts;
 
   // The sensors: noise (absolute, or a share of each channel's RMS), a bias
   // drawn once per sensor, ADC quantisation; all from the seed.

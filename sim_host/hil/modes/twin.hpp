@@ -5,6 +5,7 @@
 // estimates against.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,10 @@ namespace vines::host {
 struct TwinTruth {
   std::string path;                 // its scene ("" : the node's scene, scaled)
   std::vector<double> story_scale;  // each story's stiffness factor (eta_k x its own)
+  // Its [damage]: when it struck (the sample at damage.time_s; none without
+  // one) and each story's factor from then on (story_scale without one).
+  std::optional<double> damage_time_s;
+  std::vector<double> damaged_story_scale;
   std::vector<double> roof_x;       // top-floor displacement [m]
   std::vector<double> device_force; // VI NES: the device's force on its floor [N]; TMD, none: 0
   double tmd_frequency_factor = 1;  // truth TMD frequency / the node's design
@@ -34,10 +39,15 @@ struct TwinBench {
   TwinTruth truth;
   TwinDesign design;                 // estimator kalman only
   double strong_motion_start_s = 0;  // the record's 5 % Arias intensity time
+  // Where a detection's delay counts from: the truth's damage time when it
+  // has one, else the strong motion's start.
+  double delay_origin_s() const { return truth.damage_time_s ? *truth.damage_time_s : strong_motion_start_s; }
 };
 
 // Checks the twin options against the scene (sensors, noise, truth: same
-// story count, sensor rate and record) and runs the truth; throws
+// story count, sensor rate and record; no [damage] in the node's scene, the
+// nominal model) and runs the truth (with its [damage], switched to the
+// damaged building at damage.time_s); throws
 // std::runtime_error naming the input.
 TwinBench make_twin_bench(const Scene& scene, const HilOptions& opt, const Excitation& ex);
 

@@ -50,6 +50,8 @@ class TwinMode : public BenchMode {
     tw.estimator = estimator_ ? "kalman" : "none";
     tw.truth = tr.path;
     tw.truth_story_scales = tr.story_scale;
+    tw.truth_damage_time_s = tr.damage_time_s;
+    tw.truth_damaged_story_scales = tr.damaged_story_scale;
     tw.sensors = tb_.sensors;
     tw.noise_sd_mps2 = tb_.noise_sd;
     tw.strong_motion_start_s = tb_.strong_motion_start_s;
@@ -167,7 +169,7 @@ class TwinMode : public BenchMode {
       }
       tw->size = last->damage_size;
       if (last->onset_s >= 0) tw->onset_s = last->onset_s;
-      tw->detect_delay_s = *tw->detect_time_s - tb_.strong_motion_start_s;
+      tw->detect_delay_s = *tw->detect_time_s - tb_.delay_origin_s();
     }
     device(rec, f, device_alarm, &tw->device);
   }
