@@ -25,10 +25,11 @@ TOLERANCE_PT = {3.0: 1.0, 5.0: 1.5, 10.0: 2.0}  # a size counts as right within 
 class ErrorModel:
     """An estimate's error in the stories' loss coordinates: A mu + noise (+ h), mu uniform
     within +-mass_half (log), noise N(0, Cn), h the healthy stories' deviations (-log(1 + u), u
-    uniform within +-healthy_half) when the estimate carries them (no baseline)."""
+    uniform within +-healthy_half) when the estimate carries them (no baseline); with gauss,
+    h Gaussian of the same sd (half / sqrt(3)) instead."""
 
-    def __init__(self, A, Cn, mass_half, healthy_half=0.0):
-        self.A, self.Cn, self.mass_half, self.healthy_half = A, Cn, mass_half, healthy_half
+    def __init__(self, A, Cn, mass_half, healthy_half=0.0, gauss=False):
+        self.A, self.Cn, self.mass_half, self.healthy_half, self.gauss = A, Cn, mass_half, healthy_half, gauss
         self.Ln = np.linalg.cholesky(Cn)
 
     def cov(self):
@@ -41,7 +42,9 @@ class ErrorModel:
         n = len(self.Cn)
         mu = rng.uniform(-self.mass_half, self.mass_half, (self.A.shape[1], count))
         e = self.A @ mu + self.Ln @ rng.standard_normal((n, count))
-        if self.healthy_half:
+        if self.healthy_half and self.gauss:
+            e += self.healthy_half / np.sqrt(3) * rng.standard_normal((n, count))
+        elif self.healthy_half:
             e += -np.log1p(rng.uniform(-self.healthy_half, self.healthy_half, (n, count)))
         return e
 
@@ -134,6 +137,8 @@ def record_campaigns(F, parts, F_others, mass_half, healthy_half, false_alarm, d
             draws=draws)
     out["healthy off: no baseline"] = campaign(ErrorModel(*unknown, mass_half, healthy_half),
                                                false_alarm=false_alarm, draws=draws)
+    out["  the same, Gaussian of that sd"] = campaign(ErrorModel(*unknown, mass_half, healthy_half, gauss=True),
+                                                      false_alarm=false_alarm, draws=draws)
     return out
 
 
@@ -143,8 +148,13 @@ def node_size_errors(path):
     import json
     with open(path) as f:
         runs = json.load(f)
+    if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
+        raise ValueError("not a list of runs (tools/twin_benchmark.py --json writes one)")
     out = {}
     for r in runs:
+        missing = [key for key in ("device", "record", "damaged", "loss") if key not in r]
+        if missing:
+            raise ValueError(f"a run without {', '.join(missing)} (tools/twin_benchmark.py --json writes them)")
         if r["device"] != "none" or len(r["damaged"]) != 1 or not r.get("twin"):
             continue
         count, errs = out.setdefault(r["record"], [0, []])
@@ -165,7 +175,7 @@ def report(info, mass_half, healthy_half, false_alarm, draws, nodes=None):
     """Prints the GLRT's figures per record, then pooled (the records but Mexico City SCT, SCT,
     all); with nodes (node_size_errors()), the node's size errors against the bound's."""
     print(f"\none-story GLRT (false alarms {100 * false_alarm:g} % by Monte Carlo; masses within "
-          f"+-{100 * mass_half:g} %; healthy stories off by up to {100 * healthy_half:g} % in the last three)")
+          f"+-{100 * mass_half:g} %; healthy stories off by up to {100 * healthy_half:g} % in the last four)")
     print("  campaign                               | size sd median / largest | loss: located / sized % "
           "(within 1, 1.5, 2 points) | false alarms")
     total = sum(F for F, _ in info.values())
