@@ -4,7 +4,12 @@
 On a 3-story frame sensed at its roof: the output-error least-squares estimate of the stiffness
 factors (Gauss-Newton, masses known), over 40 noise seeds, scatters as the Cramer-Rao bound says;
 fitted to a truth whose masses are off, without noise, it moves by the bias the bound predicts.
-Also the FFT simulation against a step-by-step recursion. Usage: twin_bound_test.py SOURCE_DIR
+Also the FFT simulation against a step-by-step recursion. The one-story GLRT (tools/twin_glrt.py)
+against the estimator it models: masses drawn within 2 %, the output-error fit of the stiffnesses
+and masses (the masses' prior the tool's) over seeds, the GLRT on its estimates: their whitened
+errors, the located share of a loss and the sizes' scatter are the tool's predictions within
+sampling error; the same for the fit that keeps the nominal masses (whitened by the bias
+covariance too, and not). Usage: twin_bound_test.py SOURCE_DIR
 """
 import os
 import sys
@@ -13,10 +18,12 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(sys.argv[1], "tools"))
 import twin_bound as tb  # noqa: E402
+import twin_glrt as tg  # noqa: E402
 
 K = np.array([3.0e7, 2.5e7, 2.0e7])
 M = np.array([1.0e5, 1.0e5, 0.8e5])
 H, SENSORS, NOISE = 0.002, [3], 5.0
+LOSS = 2.5  # the GLRT checks' loss [%]: located in about half the seeds (57 % predicted)
 rng = np.random.default_rng(7)
 AG = np.convolve(rng.standard_normal(5000), np.ones(25) / 5, mode="same")  # 10 s, band-limited, ~1 m/s^2
 
@@ -35,17 +42,74 @@ def recursion(k, m, ag):
     return np.array(out)
 
 
-def fit(y, m):
-    """Output-error Gauss-Newton on log k from y, masses m assumed."""
-    theta = np.zeros(3)
-    for _ in range(6):
-        k = K * np.exp(theta)
-        r = (y - tb.outputs(k, m, AG, H, SENSORS)).ravel()
-        J = np.array([((tb.outputs(k * np.exp(e), m, AG, H, SENSORS)
-                        - tb.outputs(k * np.exp(-e), m, AG, H, SENSORS)) / 2e-5).ravel()
-                      for e in np.eye(3) * 1e-5]).T
-        theta += np.linalg.lstsq(J, r, rcond=None)[0]
+def fit(y, m, sd=None, mass_half=None, iterations=6):
+    """Output-error Gauss-Newton on log k from y, masses m assumed; with mass_half, on
+    (log k, log m) with the masses' Gaussian prior of the uniform's sd (the tool's), each
+    channel weighted by its noise sd. Returns the log factors (k, then m if fitted)."""
+    n = 6 if mass_half else 3
+    w = 1.0 if sd is None else 1.0 / sd
+    prior = np.zeros(n) if not mass_half else np.r_[np.zeros(3), np.full(3, 3 / mass_half ** 2)]
+    theta = np.zeros(n)
+    for _ in range(iterations):
+        par = lambda t: (K * np.exp(t[:3]), m * np.exp(np.r_[t, np.zeros(3)][3:6]))
+        r = ((y - tb.outputs(*par(theta), AG, H, SENSORS)) * w).ravel()
+        J = np.array([((tb.outputs(*par(theta + e), AG, H, SENSORS)
+                        - tb.outputs(*par(theta - e), AG, H, SENSORS)) * w / 2e-5).ravel()
+                      for e in np.eye(n) * 1e-5]).T
+        theta += np.linalg.solve(J.T @ J + np.diag(prior), J.T @ r - prior * theta)
     return theta
+
+
+def glrt_checks(F, y0, failures):
+    """The one-story GLRT's predictions against the fits over seeds (module docstring)."""
+    sd = NOISE / 100 * np.sqrt((y0 ** 2).mean(axis=0))
+    half, loss, seeds = 0.02, LOSS, 36
+    unknown = tg.ErrorModel(*tg.with_masses_unknown(F, half), half)
+    nominal = tg.ErrorModel(*tg.with_nominal_masses(F), half)
+    W = np.linalg.inv(unknown.cov())
+    predicted = tg.campaign(unknown, losses=(loss,), draws=4000)
+    thr = predicted["threshold"]
+    rng = np.random.default_rng(11)
+    whitened, whitened_nominal, ignored, located, size_err = [], [], [], [], []
+    for s in range(2 * seeds):
+        mu = rng.uniform(-half, half, 3)
+        story = s % 3
+        k = K.copy()
+        if s >= seeds:  # the damaged half: one story lost
+            k[story] *= 1 - loss / 100
+        y = tb.outputs(k, M * np.exp(mu), AG, H, SENSORS) + sd * rng.standard_normal(y0.shape)
+        th = -fit(y, M, sd, half, iterations=4)[:3]  # loss coordinates: -log of the factor
+        if s < seeds:
+            whitened.append(th @ W @ th)
+            thn = -fit(y, M, sd, iterations=3)
+            whitened_nominal.append(thn @ np.linalg.solve(nominal.cov(), thn))
+            ignored.append(thn @ np.linalg.solve(nominal.Cn, thn))
+        else:
+            stat, j, delta = tg.glrt(W, th[:, None])
+            located.append(stat[0] > thr and j[0] == story)
+            size_err.append((1 - np.exp(-delta[story, 0])) * 100 - loss)
+    chi = np.mean(whitened) / 3
+    chi_n, chi_i = np.mean(whitened_nominal) / 3, np.mean(ignored) / 3
+    rate, want = 100 * np.mean(located), predicted[loss][0]
+    scatter = np.sqrt(np.mean(np.square(size_err))) / np.sqrt(np.mean(predicted["size_sd"] ** 2))
+    print(f"GLRT, masses unknown within 2 %: whitened errors' mean square per story {chi:.2f} (1 predicted) over "
+          f"{seeds} seeds; {loss:g} % loss located in {rate:.0f} % of {seeds} seeds, predicted {want:.0f} %; "
+          f"size error rms / predicted sd {scatter:.2f}")
+    print(f"nominal masses: mean square per story {chi_n:.2f} whitened by noise and bias, {chi_i:.1f} by the noise "
+          "alone")
+    band = 0.75 * np.sqrt(2 / (3 * seeds)) * 3  # 3 sd of a mean of 3 seeds x chi-square(1), loosely correlated
+    if abs(chi - 1) > band:
+        failures.append("the masses-unknown estimates do not err by the tool's covariance")
+    if abs(chi_n - 1) > band:
+        failures.append("the nominal-mass estimates do not err by the noise plus the bias covariance")
+    if chi_i < 3:
+        failures.append("the nominal-mass bias does not dominate the noise (the test's frame no longer shows it)")
+    if not 15 < want < 85:
+        failures.append(f"the predicted located share {want:.0f} % is too near 0 or 100 to test")
+    if abs(rate - want) > 3 * np.sqrt(want * (100 - want) / seeds) + 2:
+        failures.append("the GLRT's located share is not the predicted one")
+    if not 0.7 < scatter < 1.35:
+        failures.append("the GLRT's sizes do not scatter by the predicted sd")
 
 
 def main():
@@ -78,6 +142,7 @@ def main():
     print(f"ideal detector, sd 0.1 %: {np.round(row, 1)}")
     if row[0] > 0 or min(row[1:]) < 100:
         failures.append("an estimator 10 times better than needed misses")
+    glrt_checks(F, y0, failures)
     for f in failures:
         print("FAILED:", f)
     sys.exit(1 if failures else 0)

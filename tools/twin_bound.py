@@ -9,11 +9,19 @@ from it (docs/twin.md section 7):
   uniform's sd): no estimator's rms error can be smaller;
 - the bias of an estimator that keeps the nominal masses (the linearised best fit of the
   stiffnesses to a truth whose masses are off): its sd per story;
-- the campaign's figures of an ideal detector, one whose estimates err exactly by the Bayesian
-  bound, with the best threshold rule whose false alarms stay within 1 %.
+- the campaign's figures of the marginal-threshold rule: estimates that err exactly by the
+  Bayesian bound, each story's alarm above max(z sd, floor), the best rule whose false alarms
+  stay within 1 %;
+- the campaign's figures of the one-story GLRT, the best detector of the hypothesis the campaign
+  poses (tools/twin_glrt.py): masses unknown; nominal masses with and without the bias in the
+  whitening; healthy stories off their nominal by up to H % with the change measured during the
+  record (the part before an onset in the Arias 25-75 % span as the baseline), against a
+  baseline from the other records, or without a baseline.
+Each record runs for max(--duration, its Arias 95 % time + 10 s), or to its end.
 
 Usage: twin_bound.py [--records DIR] [--sensors 3,6,8,10] [--noise-pct 5] [--mass-pct 2]
-                     [--duration 40] [--skip SUBSTRING ...] [--draws 400]
+                     [--healthy-pct 3] [--duration 40] [--skip SUBSTRING ...] [--draws 400]
+                     [--false-alarm 1] [--glrt-draws 300] [--onsets 5] [--node-json FILE] [--quick]
 Needs numpy and the vines Python package (build/release/python, or PYTHONPATH) to read records.
 """
 import argparse
@@ -24,6 +32,7 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import twin_glrt as glrt  # noqa: E402
 from twin_benchmark import RECORDS, TABLE1_K_MN, TABLE1_MASS_T  # noqa: E402
 
 DAMPING_S = 0.0129  # C = 0.0129 s * K (docs/model.md)
@@ -59,10 +68,10 @@ def outputs(k, m, ag, h, sensors):
     return (cv @ z).real.T
 
 
-def fisher(k, m, ag, h, sensors, noise_pct):
-    """Fisher information of (log k, log m) from the sensors' samples, each channel's white
-    noise noise_pct % of its rms; central differences of the outputs (the model is linear in
-    its state, smooth in its parameters)."""
+def jacobian(k, m, ag, h, sensors, noise_pct):
+    """The outputs' sensitivities to (log k, log m), each channel divided by its white noise's
+    sd (noise_pct % of its rms): array (2 n, samples, sensors); central differences of the
+    outputs (the model is linear in its state, smooth in its parameters)."""
     y0 = outputs(k, m, ag, h, sensors)
     sd = noise_pct / 100 * np.sqrt((y0 ** 2).mean(axis=0))
     n, step = len(k), 1e-5
@@ -72,8 +81,13 @@ def fisher(k, m, ag, h, sensors, noise_pct):
         e[j] = step
         up = outputs(k * np.exp(e[:n]), m * np.exp(e[n:]), ag, h, sensors)
         dn = outputs(k * np.exp(-e[:n]), m * np.exp(-e[n:]), ag, h, sensors)
-        jac.append(((up - dn) / (2 * step) / sd).ravel())
-    jac = np.array(jac)
+        jac.append((up - dn) / (2 * step) / sd)
+    return np.array(jac)
+
+
+def fisher(k, m, ag, h, sensors, noise_pct):
+    """Fisher information of (log k, log m) from the sensors' samples (jacobian())."""
+    jac = jacobian(k, m, ag, h, sensors, noise_pct).reshape(2 * len(k), -1)
     return jac @ jac.T
 
 
@@ -123,17 +137,38 @@ def ideal_detector(covs, draws, seed=1):
     return best
 
 
+def run_length(rec, duration, h):
+    """(ground acceleration every h over the run, Arias 25 % and 75 % times): the run lasts
+    max(duration, the Arias 95 % time + 10 s), or to the record's end if that is sooner (the
+    node's run stops there too); Arias intensity over the whole record."""
+    arias = np.cumsum(rec.acc ** 2)
+    arias /= arias[-1]
+    at = lambda p: rec.t[np.searchsorted(arias, p)]
+    t = np.arange(0.0, min(max(duration, at(0.95) + 10.0), rec.t[-1]), h)
+    return np.interp(t, rec.t, rec.acc), at(0.25), at(0.75)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--records", default=os.path.join(ROOT, "..", "shared", "data", "ground_motions"))
     ap.add_argument("--sensors", default="3,6,8,10")
     ap.add_argument("--noise-pct", type=float, default=5.0)
     ap.add_argument("--mass-pct", type=float, default=2.0, help="masses off by up to this, uniformly")
-    ap.add_argument("--duration", type=float, default=40.0)
+    ap.add_argument("--healthy-pct", type=float, default=3.0,
+                    help="healthy stories' stiffness off by up to this, uniformly (section 3 of the GLRT)")
+    ap.add_argument("--duration", type=float, default=40.0, help="at least this long, else Arias 95 %% + 10 s")
     ap.add_argument("--rate", type=float, default=1000.0, help="sensor rate [Hz]")
     ap.add_argument("--skip", nargs="*", default=[], help="leave out records whose name holds one of these")
     ap.add_argument("--draws", type=int, default=400, help="ideal detector's draws per record")
+    ap.add_argument("--false-alarm", type=float, default=1.0, help="the GLRT's false alarms [%%]")
+    ap.add_argument("--glrt-draws", type=int, default=300, help="GLRT draws per record, story and loss")
+    ap.add_argument("--onsets", type=int, default=5, help="onsets in the Arias 25-75 %% span (during the record)")
+    ap.add_argument("--node-json", help="a tools/twin_benchmark.py --json file: the node's size errors against "
+                    "the bound's")
+    ap.add_argument("--quick", action="store_true", help="fewer draws and onsets (a minute less, figures rougher)")
     args = ap.parse_args()
+    if args.quick:
+        args.draws, args.glrt_draws, args.onsets = 100, 60, 2
     try:
         sensors = [int(s) for s in args.sensors.split(",")]
     except ValueError:
@@ -141,9 +176,19 @@ def main():
     if not all(1 <= s <= 10 for s in sensors) or len(set(sensors)) != len(sensors):
         sys.exit(f"twin_bound.py: error: --sensors {args.sensors}: floors 1-10, each once")
     for name, v, lo in (("--noise-pct", args.noise_pct, 0), ("--mass-pct", args.mass_pct, 0),
-                        ("--duration", args.duration, 0), ("--rate", args.rate, 0), ("--draws", args.draws, 0)):
+                        ("--duration", args.duration, 0), ("--rate", args.rate, 0), ("--draws", args.draws, 0),
+                        ("--healthy-pct", args.healthy_pct, 0), ("--false-alarm", args.false_alarm, 0),
+                        ("--glrt-draws", args.glrt_draws, 0), ("--onsets", args.onsets, 0)):
         if not (np.isfinite(v) and v > lo):
             sys.exit(f"twin_bound.py: error: {name} {v}: must be a positive number")
+    if args.false_alarm >= 100:
+        sys.exit(f"twin_bound.py: error: --false-alarm {args.false_alarm}: a percentage under 100")
+    nodes = None
+    if args.node_json:
+        try:
+            nodes = glrt.node_size_errors(args.node_json)
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            sys.exit(f"twin_bound.py: error: --node-json {args.node_json}: {e}")
     try:
         sys.path.insert(0, os.path.join(ROOT, "build", "release", "python"))
         import vines
@@ -157,10 +202,11 @@ def main():
     h = 1.0 / args.rate
     mass_sd = args.mass_pct / 100 / np.sqrt(3)
     print(f"twin bound: bare Table 1 frame, floors {args.sensors} at {args.rate:g} Hz, noise {args.noise_pct:g} % rms, "
-          f"masses within +-{args.mass_pct:g} %, first {args.duration:g} s")
-    print("record | sd, masses known (largest) | Bayesian bound, masses unknown (median / largest) "
+          f"masses within +-{args.mass_pct:g} %, each record for max({args.duration:g} s, Arias 95 % + 10 s) "
+          "or to its end")
+    print("record | run s | sd, masses known (largest) | Bayesian bound, masses unknown (median / largest) "
           "| nominal-mass estimator's bias sd (median / largest)")
-    covs = []
+    covs, info = [], {}
     for name in sorted(RECORDS):
         if any(s in name for s in args.skip):
             continue
@@ -169,17 +215,28 @@ def main():
             rec = vines.Record.load(path, **RECORDS[name])
         except Exception as e:  # the package's RecordError names the file and the reason
             sys.exit(f"twin_bound.py: error: {e}")
-        t = np.arange(0.0, min(args.duration, rec.t[-1]), h)
-        ag = np.interp(t, rec.t, rec.acc)
-        known, cov, bias = bounds(fisher(k, m, ag, h, sensors, args.noise_pct), mass_sd)
+        ag, t25, t75 = run_length(rec, args.duration, h)
+        jac = jacobian(k, m, ag, h, sensors, args.noise_pct)
+        F = np.einsum("itc,jtc->ij", jac, jac)
+        parts = []
+        for q in (np.arange(args.onsets) + 0.5) / args.onsets:  # onsets spread evenly over the span
+            i0 = int(round((t25 + q * (t75 - t25)) / h))
+            before = np.einsum("itc,jtc->ij", jac[:, :i0], jac[:, :i0])
+            parts.append((before, F - before))
+        del jac
+        info[name] = (F, parts)
+        known, cov, bias = bounds(F, mass_sd)
         bayes = np.sqrt(np.diag(cov))
         covs.append(cov)
-        print(f"{name[:44]:44s} | {100 * known.max():5.2f} % | {100 * np.median(bayes):5.2f} / {100 * bayes.max():5.2f} % "
-              f"| {100 * np.median(bias):5.2f} / {100 * bias.max():5.2f} %", flush=True)
+        print(f"{name[:44]:44s} | {len(ag) * h:5.1f} | {100 * known.max():5.2f} % | {100 * np.median(bayes):5.2f} / "
+              f"{100 * bayes.max():5.2f} % | {100 * np.median(bias):5.2f} / {100 * bias.max():5.2f} %", flush=True)
+    if not info:
+        sys.exit("twin_bound.py: error: --skip left no record")
     (z, floor), row = ideal_detector(covs, args.draws)
-    print(f"ideal detector (errors at the Bayesian bound; alarm above max({z:g} sd, {floor:g} %)): "
+    print(f"marginal-threshold rule (errors at the Bayesian bound; alarm above max({z:g} sd, {floor:g} %)): "
           f"false alarms {row[0]:.1f} %; 5 % loss located {row[1]:.1f} %, size within 1.5 points {row[2]:.1f} %; "
           f"10 % loss located {row[3]:.1f} %, size within 2 points {row[4]:.1f} %")
+    glrt.report(info, args.mass_pct / 100, args.healthy_pct / 100, args.false_alarm / 100, args.glrt_draws, nodes)
 
 
 if __name__ == "__main__":
