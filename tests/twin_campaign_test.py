@@ -9,7 +9,6 @@ a root-finding of its definition. Then `vines hil` through the tool, when the pr
 Usage: twin_campaign_test.py SOURCE_DIR [VINES]   (or pytest with VINES_SOURCE_DIR / VINES_EXE)
 """
 import json
-import math
 import os
 import random
 import subprocess
@@ -190,7 +189,12 @@ def test_table_arithmetic():
     # undamaged: 300 runs, 2 alarms; "story not identified" is no location
     res += [synthetic("undamaged", 0.0, [], dict(detected=i < 2)) for i in range(300)]
     res.append(synthetic("before", 0.05, [2], dict(detected=True, stories=[2], story_identified=False)))
+    # two stories: both named; a report that names one story alone: one of them
+    res.append(synthetic("two during", 0.10, [3, 7], dict(detected=True, stories=[3, 7], detect_time_s=30.0)))
+    res.append(synthetic("two during", 0.10, [3, 7], dict(detected=True, stories=[3], detect_time_s=30.0)))
+    res.append(synthetic("two during", 0.10, [3, 7], dict(detected=True, story=7, detect_time_s=30.0)))
     rows = {(r[1], r[2]): dict(zip(ct.HEAD, r)) for r in ct.rows(res)}
+    assert rows[("bare", "two during 0.1")]["located"].startswith(" 66.7 %")
     d = rows[("bare", "during 0.1")]
     assert d["runs"] == "21" and d["failed"] == "1"
     assert d["detected"].startswith(" 95.0 %")                     # 19/20
@@ -220,6 +224,13 @@ def test_device_health():
     assert h["impulse within 25 %"][2].startswith("2/4 = 50.0 %") and h["impulse within 25 %"][2].endswith("✗)")
     assert h["stuck reported"][2].startswith("2/3 = 66.7 %")
     assert h["stuck on a moving sphere"][2].startswith("0/4 = 0.0 %") and h["stuck on a moving sphere"][2].endswith("✓)")
+
+
+def test_limit_keeps_every_family(design):
+    _, _, cases = design
+    families = list(dict.fromkeys(c["family"] for c in cases))
+    few = tb.limited(cases, len(families))
+    assert [c["family"] for c in few] == families
 
 
 def tool(*args, **kw):

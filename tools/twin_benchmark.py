@@ -98,7 +98,7 @@ def baseline_cases(args, records, rng_seed):
                     rec = recs[k % len(recs)]
                     k += 1
                     truth = json.loads(json.dumps(healthy))
-                    truth["frame"]["stiffness_scales"] = [b * (1 - loss if i == s - 1 else 1) for i, b in enumerate(base)]
+                    truth.setdefault("frame", {})["stiffness_scales"] = [b * (1 - loss if i == s - 1 else 1) for i, b in enumerate(base)]
                     truth["record"] = dict({"path": rec["path"]}, **RECORDS[rec["name"]])
                     out.append(dict(family="before baseline", label=f"loss {round(100 * loss)} % before, baseline",
                                     device=device, record=rec["path"], sct=rec["sct"], truth=truth, damaged=[s],

@@ -50,6 +50,8 @@ def score(r):
     stories = named(t)
     located = bool(damaged) and det and t.get("story_identified", True) is not False and \
         sorted(stories) == sorted(damaged)
+    if len(damaged) > 1 and t.get("stories") is None:  # a report naming one story: one of them
+        located = det and t.get("story") in damaged
     s = dict(detected=det, located=located, size_err=None, onset_err=None, delay=None, located20=None)
     if det and onset is not None and t.get("detect_time_s") is not None:
         s["delay"] = t["detect_time_s"] - onset
