@@ -117,6 +117,7 @@ def test_duration_rule_and_sct_separate(design):
         assert c["sct"] == ("_SCT_" in c["record"])
     rows = ct.rows([dict(case=c, twin=dict(detected=False), steps=1, wall=0.0) for c in cases])
     assert {r[0] for r in rows} == {"9 records", "SCT", "every record"}
+    assert sum(int(r[3]) for r in rows if r[0] == "every record" and r[1] != "all") == len(cases)
     for r in rows:
         if r[0] == "SCT":
             assert int(r[3]) == sum(c["sct"] and c["device"] == {"bare": "none", "TMD": "tmd", "VI NES": "vines"}[r[1]]

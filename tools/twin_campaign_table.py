@@ -110,18 +110,20 @@ HEAD = ("records", "device", "truth", "runs", "failed", "detected", "located", "
 
 
 def rows(results, bound_located=None):
-    """The table's rows (tuples of strings, HEAD's columns): per records set (nine records, SCT),
-    device and truth; then every device and record together for the undamaged runs (the false
-    alarm target counts them all). bound_located: loss -> the bound tool's located share, for
+    """The table's rows (tuples of strings, HEAD's columns): per records set (the nine records,
+    SCT, every record: the targets hold for every record), device and truth; then every device
+    and record together for the undamaged runs (the false alarm target counts them all). bound_located: loss -> the bound tool's located share, for
     the before-the-record rows' target (0.9 x it)."""
     groups = {}
     for r in results:
         k = group_key(r)
         groups.setdefault(k, []).append(r)
+        groups.setdefault(("every record",) + k[1:], []).append(r)
         if r["case"]["family"] == "undamaged":
             groups.setdefault(("every record", "all", "undamaged", 0.0, "undamaged"), []).append(r)
     out = []
-    for key in sorted(groups, key=lambda k: (k[0] == "every record", k[0], k[1] == "all", k[1], ORDER[k[2]], k[3])):
+    section = {"9 records": 0, "SCT": 1, "every record": 2}
+    for key in sorted(groups, key=lambda k: (section[k[0]], k[1] == "all", k[1], ORDER[k[2]], k[3])):
         where, device, family, loss, label = key
         rs = groups[key]
         ok = [r for r in rs if "twin" in r]
