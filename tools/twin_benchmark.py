@@ -32,6 +32,7 @@ import collections
 import concurrent.futures as cf
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -255,6 +256,9 @@ def main(argv=None):
             if n % 20 == 0 or n == len(todo):
                 print(f"twin_benchmark.py: {n}/{len(todo)} runs, {(time.monotonic() - start) / 60:.1f} min",
                       file=sys.stderr, flush=True)
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu_used = used.ru_utime + used.ru_stime
+    simulated = sum(args.duration or c["duration_s"] for c in todo)
     order = {id(c): i for i, c in enumerate(todo)}
     results.sort(key=lambda r: order[id(r["case"])])
     errors = [r for r in results if "error" in r]
@@ -264,7 +268,8 @@ def main(argv=None):
     print(f"twin benchmark: sensors {args.sensors} at 1 kHz, noise {args.noise_pct:g} % RMS, {len(records)} records "
           f"(each to max(40 s, Arias 95 % + 10 s)), healthy stories within {cc.HEALTHY_K_PCT:g} %, masses within "
           f"{cc.MASS_PCT:g} %, {len(results)} runs ({len(errors)} failed), "
-          f"{(time.monotonic() - start) / 60:.1f} min on {args.jobs} jobs, design seed {args.design_seed}")
+          f"{(time.monotonic() - start) / 60:.1f} min on {args.jobs} jobs ({40 * cpu_used / max(1e-9, simulated):.2f} s "
+          f"CPU per 40 s of record; estimated {40 * CPU_S_PER_RECORD_S:g}), design seed {args.design_seed}")
     ct.print_all(results, args.bound)
     if args.calibrate:
         worst = sorted(max(1 - e for e in r["twin"]["eta_k"]) for r in results if "twin" in r)
