@@ -32,6 +32,7 @@ import collections
 import concurrent.futures as cf
 import json
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -131,8 +132,9 @@ def run(args, tmp, i, case):
     finally:
         for path in (node, tpath):
             os.remove(path)
-    if p.returncode not in (0, 3):
-        return dict(case=case, error=p.stderr.strip() or f"exit {p.returncode}")
+    if p.returncode not in (0, 3):  # the scenes' temporary names left out: one message, one line of the list
+        err = re.sub(r"<(node|truth)>:\d+:", r"<\1>:", p.stderr.strip().replace(tpath, "<truth>").replace(node, "<node>"))
+        return dict(case=case, error=err or f"exit {p.returncode}")
     try:
         r = json.loads(p.stdout)
         return dict(case=case, twin=r["twin"], steps=r["steps"], wall=r["wall_time_s"])
@@ -258,8 +260,8 @@ def main(argv=None):
                       file=sys.stderr, flush=True)
     used = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu_used = used.ru_utime + used.ru_stime
-    simulated = sum(args.duration or c["duration_s"] for c in todo)
     order = {id(c): i for i, c in enumerate(todo)}
+    simulated = sum(args.duration or r["case"]["duration_s"] for r in results if "twin" in r)
     results.sort(key=lambda r: order[id(r["case"])])
     errors = [r for r in results if "error" in r]
     if args.json:
@@ -269,7 +271,7 @@ def main(argv=None):
           f"(each to max(40 s, Arias 95 % + 10 s)), healthy stories within {cc.HEALTHY_K_PCT:g} %, masses within "
           f"{cc.MASS_PCT:g} %, {len(results)} runs ({len(errors)} failed), "
           f"{(time.monotonic() - start) / 60:.1f} min on {args.jobs} jobs ({40 * cpu_used / max(1e-9, simulated):.2f} s "
-          f"CPU per 40 s of record; estimated {40 * CPU_S_PER_RECORD_S:g}), design seed {args.design_seed}")
+          f"CPU per 40 s of record run; estimated {40 * CPU_S_PER_RECORD_S:g}), design seed {args.design_seed}")
     ct.print_all(results, args.bound)
     if args.calibrate:
         worst = sorted(max(1 - e for e in r["twin"]["eta_k"]) for r in results if "twin" in r)
