@@ -1,50 +1,54 @@
 #!/usr/bin/python3
-"""The twin monitor's benchmark campaign (docs/twin.md section 8).
+"""The twin monitor's benchmark campaign (docs/twin.md section 8, issue 52).
 
-Runs `vines hil NODE_SCENE --mode twin --truth TRUTH` over: the three devices
-(bare frame, TMD, VI NES: the node scenes data/scenes/elcentro_{bare,tmd,vines}.toml);
-every record in the ground-motion folder; truths that are undamaged (masses
-off by up to 2 % per floor, VI NES eps off by up to 2 %, the sphere or the TMD
-started elsewhere), have lost 5, 10 or 20 % of one story (every story), or
-10 % of two; detuned TMDs (frequency 10 % low and high); and noise seeds.
-Sensors: the ground as the node's input and floors 3, 6, 8, 10, 5 % RMS noise.
-Prints one table: detection, localisation, size error, delay after strong
-motion, false alarms, roof NRMSE, host time per step; with --calibrate, the
-undamaged runs' largest loss estimate (the alarm's 3 % floor comes from it).
+Runs `vines hil NODE_SCENE --mode twin --truth TRUTH` over: the three devices (bare frame, TMD,
+VI NES: the nominal Table 1 frame, as data/scenes/elcentro_{bare,tmd,vines}.toml); every record
+of the ground-motion folder, each run to max(40 s, its 95 % Arias time + 10 s) (Arias over the
+whole record; Mexico City SCT, whose strong motion lies after 40 s, on lines of its own); truths
+that are not their drawing (each story's stiffness within 3 %, each floor's mass within 2 %, VI
+NES eps within 2 %, the sphere or the TMD started elsewhere), undamaged, or losing 3, 5, 10 or
+20 % of one story at an onset drawn in the record's 25-75 % Arias span (every story and loss,
+spread over the records and noise seeds by a sampled design, deterministic from --design-seed),
+two stories 10 % during the record, one story 5 or 10 % before it (no baseline; with
+--baseline-dir also from a commissioned baseline); detuned TMDs; a stuck sphere. Sensors: the
+ground as the node's input and floors 3, 6, 8, 10 at 1 kHz, 5 % RMS noise.
 
-Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--seeds N]
-                         [--undamaged N] [--duration S] [--quick] [--calibrate]
-                         [--json FILE] [--sensors LIST] [--noise-pct P]
-Exit 2 with a message naming the input on a missing program, folder or scene.
+Prints the planned run count and an estimated time first, then one table: detection,
+localisation (and within 20 s of onset), size error and share within 1 / 1.5 / 2 points, onset
+error and share within 2 s, delay, false alarms with a 95 % Wilson interval, roof NRMSE, host
+time per step, each figure beside its target (issue 52) with a pass/fail mark; the devices'
+health (VI NES impulse within 25 %, stuck sphere reported, never on a moving one; TMD detuned);
+the failed runs, counted and listed. With --calibrate, undamaged runs only and their largest
+final loss estimate. Options the tool does not know go to `vines hil` (e.g. --twin-loss-min).
+
+Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--quick] [--seeds N]
+                         [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES]
+                         [--limit N] [--duration S] [--baseline-dir DIR] [--bound-located 5=P,10=P]
+                         [--calibrate] [--json FILE] [--sensors LIST] [--noise-pct P] [--plan]
+Exit 2 with a message naming the input on a missing program, folder, record or baseline file.
 """
 import argparse
+import collections
 import concurrent.futures as cf
 import json
 import os
-import random
 import re
+import resource
 import statistics
 import subprocess
 import sys
 import tempfile
+import time
+import tomllib
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TABLE1_MASS_T = [179, 170, 161, 152, 143, 134, 125, 116, 107, 98]
-TABLE1_K_MN = [62.47, 52.26, 56.14, 53.02, 49.91, 46.79, 43.67, 40.55, 37.43, 34.31]
-TMD_K, TMD_C = 488732.6137915217, 44133.36142032142  # the Den Hartog design of elcentro_tmd.toml
-GAP_M = 0.4148  # the VI NES sphere's free travel each side of the box centre (elcentro_vines.toml)
-RECORDS = {  # file -> [record] keys (formats as data/studies/records.toml)
-    "elcentro_1940_ns_2688pts_dt002_time_g.dat": {"format": "time-accel", "units": "g"},
-    "elcentro_1940_ns_peknold_dt002.at2": {"format": "at2"},
-    "elcentro_1940_ns_peer_legacy_I-ELC180_dt001.at2": {"format": "at2"},
-    "elcentro_1940_ns_peer_nga_west2_rsn6_I-ELC180.at2": {"format": "at2"},
-    "taft_1952_kern_county_TAF021_nga_west2_rsn15.at2": {"format": "at2"},
-    "kobe_1995_KJMA_000_ns_nga_west2_rsn1106.at2": {"format": "at2"},
-    "northridge_1994_rinaldi_228_nga_rsn1063.at2": {"format": "at2"},
-    "northridge_1994_sylmar_county_hospital_ns_time_ms2.dat": {"format": "time-accel", "units": "m/s2"},
-    "lomaprieta_1989_corralitos_CLS000_nga_west2_rsn753.at2": {"format": "at2"},
-    "mexico_1985_michoacan_SCT_time_ns_ew_v_g.txt": {"format": "time-accel", "units": "g", "column": 2},
-}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import twin_campaign_cases as cc  # noqa: E402
+import twin_campaign_table as ct  # noqa: E402
+from twin_campaign_cases import (GAP_M, RECORDS, ROOT, TABLE1_K_MN, TABLE1_MASS_T, TMD_C, TMD_K,  # noqa: E402,F401
+                                 building)
+
+CPU_S_PER_RECORD_S = 2.5 / 40  # a twin run's CPU per second of record (2-core VM, 1 kHz)
+FAMILIES = ("undamaged", "during", "two during", "before", "before baseline", "detuned", "stuck")
 
 
 def fail(msg):
@@ -67,185 +71,213 @@ def scene_text(tables):
                    for name, keys in tables.items() if keys is not None)
 
 
-def building(device, record, *, masses=None, scales=None, eps=0.7, x0=0.0, tmd_k=None, tmd_x0=0.0):
-    """A scene's tables: the Table 1 frame (masses, per-story scales), a device, a record."""
-    frame = {"preset": "table1"}
-    if masses:
-        frame = {"preset": "custom", "masses_kg": [m * 1e3 for m in masses],
-                 "stiffnesses_n_per_m": [k * 1e6 for k in TABLE1_K_MN], "damping": "stiffness",
-                 "stiffness_damping_s": 0.0129}
-    if scales:
-        frame["stiffness_scales"] = scales
-    t = {"scene": {"name": "twin_bench"}, "frame": frame, "device": {"kind": device}}
-    if device != "none":
-        t["device"]["mass_ratio"] = 0.05
-    if device == "vines":
-        t["vines"] = {"law": "kuwabara", "beta": 1.35, "eps": eps, "v_ref_mps": 0.5, "initial_position_m": x0}
-    if device == "tmd":
-        t["tmd"] = {"initial_position_m": tmd_x0}
-        if tmd_k:
-            t["tmd"].update({"k_n_per_m": tmd_k, "c_ns_per_m": TMD_C})
-    t["record"] = dict({"path": record}, **RECORDS[os.path.basename(record)])
-    t["loop"] = {"sensor_rate_hz": 1000.0}
-    return t
-
-
-def perturbed(rng, device, record, **kw):
-    """A truth whose masses (and eps, and the device's start) are off the node's model."""
-    masses = [m * (1 + 0.02 * rng.uniform(-1, 1)) for m in TABLE1_MASS_T]
-    return building(device, record, masses=masses, eps=0.7 * (1 + 0.02 * rng.uniform(-1, 1)),
-                    x0=0.8 * GAP_M * rng.uniform(-1, 1), tmd_x0=0.05 * rng.uniform(-1, 1), **kw)
-
-
-def cases(args, records):
-    """(label, device, record, truth tables, damaged stories, loss, seed) for every run."""
-    rng = random.Random(20261125)
-    losses = [0.10] if args.quick else [0.05, 0.10, 0.20]
-    stories = [3, 8] if args.quick else range(1, 11)
-    pairs = [] if args.quick else [(2, 7), (4, 9)]
-    out = []
-    for device in ("none", "tmd", "vines"):
-        for rec in records:
-            for seed in range(1, args.seeds + 1):
-                for _ in range(args.undamaged):
-                    out.append(("undamaged", device, rec, perturbed(rng, device, rec), [], 0.0, seed))
-                if args.calibrate:
-                    continue
-                for s in stories:
-                    for loss in losses:
-                        sc = [1.0] * 10
-                        sc[s - 1] = 1 - loss
-                        out.append((f"loss {round(100 * loss)} %", device, rec,
-                                    perturbed(rng, device, rec, scales=sc), [s], loss, seed))
-                for a, b in pairs:
-                    sc = [1.0] * 10
-                    sc[a - 1] = sc[b - 1] = 0.9
-                    out.append(("two stories 10 %", device, rec, perturbed(rng, device, rec, scales=sc),
-                                [a, b], 0.1, seed))
-                if device == "tmd":
-                    for f in (0.9, 1.1):
-                        out.append((f"TMD detuned {round(100 * (f - 1)):+d} %", device, rec,
-                                    perturbed(rng, device, rec, tmd_k=TMD_K * f * f), [], 0.0, seed))
+def baseline_cases(args, records, rng_seed):
+    """Losses of 5 and 10 % before the record on the building a baseline was commissioned on:
+    DIR/<device>.toml (that healthy building, a truth scene), DIR/<device>.baseline (for
+    `vines hil --baseline`), DIR/<device>.records (optional: the records it was commissioned
+    on, one file name a line, left out here)."""
+    import random
+    rng, out = random.Random(rng_seed + 1), []
+    for device in cc.DEVICES:
+        paths = {e: os.path.join(args.baseline_dir, f"{device}.{e}") for e in ("toml", "baseline", "records")}
+        for e in ("toml", "baseline"):
+            if not os.path.isfile(paths[e]):
+                fail(f"{paths[e]}: no such file (--baseline-dir holds <device>.toml and <device>.baseline "
+                     f"for the devices {', '.join(cc.DEVICES)})")
+        with open(paths["toml"], "rb") as f:
+            healthy = tomllib.load(f)
+        used = set()
+        if os.path.isfile(paths["records"]):
+            used = {line.strip() for line in open(paths["records"]) if line.strip()}
+        recs = [r for r in records if r["name"] not in used]
+        if not recs:
+            fail(f"{paths['records']}: every record was used to commission the baseline: none left to test on")
+        base = healthy.get("frame", {}).get("stiffness_scales", [1.0] * 10)
+        k = 0
+        for loss in (0.05, 0.10):
+            for s in range(1, 11):
+                for _ in range(2 if not args.quick else 1):
+                    rec = recs[k % len(recs)]
+                    k += 1
+                    truth = json.loads(json.dumps(healthy))
+                    truth.setdefault("frame", {})["stiffness_scales"] = [b * (1 - loss if i == s - 1 else 1) for i, b in enumerate(base)]
+                    truth["record"] = dict({"path": rec["path"]}, **RECORDS[rec["name"]])
+                    out.append(dict(family="before baseline", label=f"loss {round(100 * loss)} % before, baseline",
+                                    device=device, record=rec["path"], sct=rec["sct"], truth=truth, damaged=[s],
+                                    loss=loss, onset_s=None, healthy=base, masses=None,
+                                    seed=1 + rng.randrange(args.seeds), duration_s=rec["duration_s"],
+                                    baseline=paths["baseline"]))
     return out
 
 
 def run(args, tmp, i, case):
-    label, device, rec, truth, damaged, loss, seed = case
+    """One `vines hil` twin run: the case with its report (twin, steps, wall) or its error."""
     node = os.path.join(tmp, f"node_{i}.toml")
     tpath = os.path.join(tmp, f"truth_{i}.toml")
     with open(node, "w") as f:
-        f.write(scene_text(building(device, rec)))
+        f.write(scene_text(building(case["device"], case["record"])))
     with open(tpath, "w") as f:
-        f.write(scene_text(truth))
+        f.write(scene_text(case["truth"]))
+    duration = args.duration or case["duration_s"]
     cmd = [args.vines, "hil", node, "--mode", "twin", "--truth", tpath, "--sensors", args.sensors,
-           "--measure-noise-pct", str(args.noise_pct), "--seed", str(seed), "--json", "--timeout", "60"]
-    if args.duration:
-        cmd += ["--duration", str(args.duration)]
+           "--measure-noise-pct", str(args.noise_pct), "--seed", str(case["seed"]), "--json",
+           "--timeout", str(args.timeout), "--duration", f"{duration:.3f}"]
+    if case.get("baseline"):
+        cmd += ["--baseline", case["baseline"]]
     cmd += args.extra
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    for path in (node, tpath):
-        os.remove(path)
-    if p.returncode not in (0, 3):
-        return dict(case=case, error=p.stderr.strip() or f"exit {p.returncode}")
-    r = json.loads(p.stdout)
-    return dict(case=case, twin=r["twin"], steps=r["steps"], wall=r["wall_time_s"])
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.run_timeout)
+    except subprocess.TimeoutExpired:
+        return dict(case=case, error=f"still running after {args.run_timeout:g} s (--run-timeout)")
+    finally:
+        for path in (node, tpath):
+            os.remove(path)
+    if p.returncode not in (0, 3):  # the scenes' temporary names left out: one message, one line of the list
+        err = re.sub(r"<(node|truth)>:\d+:", r"<\1>:", p.stderr.strip().replace(tpath, "<truth>").replace(node, "<node>"))
+        return dict(case=case, error=err or f"exit {p.returncode}")
+    try:
+        r = json.loads(p.stdout)
+        return dict(case=case, twin=r["twin"], steps=r["steps"], wall=r["wall_time_s"])
+    except (ValueError, KeyError) as e:
+        return dict(case=case, error=f"unreadable report ({e}): {p.stdout[:200]!r}")
 
 
-def pct(xs):
-    return f"{100 * sum(xs) / len(xs):5.1f} %" if xs else "    -  "
+def limited(todo, n):
+    """n runs taken round-robin over the families (a small campaign that still has each)."""
+    by = collections.OrderedDict()
+    for c in todo:
+        by.setdefault(c["family"], []).append(c)
+    out = []
+    while len(out) < n and any(by.values()):
+        for fam in by:
+            if by[fam] and len(out) < n:
+                out.append(by[fam].pop(0))
+    return out
 
 
-def stat(xs, fmt):
-    if not xs:
-        return "-"
-    xs = sorted(xs)
-    return (fmt % statistics.fmean(xs)) + " / " + (fmt % xs[min(len(xs) - 1, int(0.9 * len(xs)))])
-
-
-def table(results):
-    groups = {}
-    for r in results:
-        if "error" in r:
-            continue
-        label, device = r["case"][0], r["case"][1]
-        groups.setdefault((device, label), []).append(r)
-    head = ("device", "truth", "runs", "detected", "located", "size err pt mean/p90", "delay s mean/p90",
-            "false alarm", "roof NRMSE mean/p90", "us/step")
-    rows = []
-    for (device, label), rs in sorted(groups.items()):
-        tw = [r["twin"] for r in rs]
-        damaged = [r["case"][4] for r in rs]
-        loss = [r["case"][5] for r in rs]
-        det = [t["detected"] for t in tw]
-        if label.startswith("TMD"):
-            det = [t["device"].get("detuned", False) for t in tw]
-        loc = [t["story"] in d for t, d in zip(tw, damaged)] if damaged[0] else []
-        size = [100 * abs(t["size"] - l) for t, d, l in zip(tw, damaged, loss)
-                if t["detected"] and t["size"] is not None and t["story"] in d and len(d) == 1]
-        delay = [t["detect_delay_s"] for t in tw if t["detected"] and t["detect_delay_s"] is not None]
-        nrmse = [t["roof_displacement_nrmse"] for t in tw if t["roof_displacement_nrmse"] is not None]
-        us = [1e6 * r["wall"] / max(1, r["steps"]) for r in rs]
-        damaged_run = bool(damaged[0]) or label.startswith("TMD")
-        rows.append((device, label, str(len(rs)), pct(det) if damaged_run else "", pct(loc) if loc else "",
-                     stat(size, "%.2f"), stat(delay, "%.1f"), "" if damaged_run else pct(det),
-                     stat(nrmse, "%.4f"), "%.0f" % statistics.fmean(us)))
-    widths = [max([len(h)] + [len(r[i]) for r in rows]) for i, h in enumerate(head)]
-    line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"
-    print(line(head))
-    print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    for r in rows:
-        print(line(r))
-
-
-def main():
+def parse_args(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--vines", default=os.path.join(ROOT, "build", "release", "vines"))
     ap.add_argument("--records", default=os.environ.get("VINES_GROUND_MOTIONS",
                                                         os.path.join(ROOT, "..", "shared", "data", "ground_motions")))
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    ap.add_argument("--seeds", type=int, default=1)
-    ap.add_argument("--undamaged", type=int, default=4, help="undamaged truths per device, record and seed")
-    ap.add_argument("--duration", type=float, default=60, help="first S seconds of each record (0: all)")
+    ap.add_argument("--seeds", type=int, default=5, help="noise seeds 1..N, spread over the runs")
+    ap.add_argument("--undamaged", type=int, help="undamaged truths per device and record (15; quick 3)")
+    ap.add_argument("--replicates", type=int,
+                    help="runs per device, story and loss during the record (10; quick 0: each once over the devices)")
+    ap.add_argument("--design-seed", type=int, default=20261125, help="the design's seed: truths, onsets, assignment")
+    ap.add_argument("--only", help="families, comma-separated: " + ", ".join(FAMILIES))
+    ap.add_argument("--limit", type=int, help="the first N runs, round-robin over the families")
+    ap.add_argument("--duration", type=float, help="S seconds of every record instead of the Arias rule")
+    ap.add_argument("--timeout", type=float, default=60, help="vines hil --timeout: longest wait for the node [s]")
+    ap.add_argument("--run-timeout", type=float, default=900, help="a run still going after S seconds has failed")
     ap.add_argument("--sensors", default="3,6,8,10")
     ap.add_argument("--noise-pct", type=float, default=5)
-    ap.add_argument("--quick", action="store_true", help="stories 3 and 8, 10 % only, no pairs")
+    ap.add_argument("--quick", action="store_true", help="about 150 runs: each story and loss once over the devices")
     ap.add_argument("--calibrate", action="store_true", help="undamaged truths only; their largest estimates")
+    ap.add_argument("--baseline-dir", help="adds losses before the record with a baseline (see baseline_cases)")
+    ap.add_argument("--bound-located", help="loss=share of the bound tool's one-story GLRT, e.g. 5=0.27,10=0.95: "
+                                            "the before-the-record rows' target is 0.9 x it")
+    ap.add_argument("--plan", action="store_true", help="print the planned runs and the time estimate, run nothing")
     ap.add_argument("--json", help="write every run's case and twin report to FILE")
-    args, args.extra = ap.parse_known_args()
-    if not os.access(args.vines, os.X_OK):
+    args, args.extra = ap.parse_known_args(argv)
+    return args
+
+
+def prepare(args):
+    """The checked inputs and the runs: (records' info, cases). Exits 2 naming what is missing."""
+    if not args.plan and not os.access(args.vines, os.X_OK):
         fail(f"{args.vines}: not an executable (build it: cmake --preset release && cmake --build --preset release)")
     if not os.path.isdir(args.records):
         fail(f"{args.records}: no such folder of ground motions (--records, or VINES_GROUND_MOTIONS)")
-    records = [os.path.join(args.records, f) for f in RECORDS if os.path.exists(os.path.join(args.records, f))]
-    if not records:
-        fail(f"{args.records}: none of the known records is there")
-    todo = cases(args, records)
-    results = []
+    records = []
+    for name in RECORDS:
+        path = os.path.join(args.records, name)
+        if not os.path.isfile(path):
+            fail(f"{path}: no such record (the campaign runs every record of RECORDS in {args.records})")
+        try:
+            records.append(cc.record_info(path, args.vines))
+        except Exception as e:  # the package's RecordError names the file and the reason
+            fail(f"{path}: unreadable record: {e}")
+    families = None
+    if args.only:
+        families = [f.strip() for f in args.only.split(",") if f.strip()]
+        for f in families:
+            if f not in FAMILIES:
+                fail(f"--only {f}: not a family ({', '.join(FAMILIES)})")
+    if args.bound_located:
+        try:
+            args.bound = {int(k) / 100: float(v) for k, v in (x.split("=") for x in args.bound_located.split(","))}
+        except ValueError:
+            fail(f"--bound-located {args.bound_located}: expected LOSS_PCT=SHARE,..., e.g. 5=0.27,10=0.95")
+    else:
+        args.bound = None
+    todo = cc.cases(records, quick=args.quick, seed=args.design_seed, seeds=args.seeds, calibrate=args.calibrate,
+                    undamaged=args.undamaged, replicates=args.replicates, families=families)
+    if args.baseline_dir and not args.calibrate:
+        if not os.path.isdir(args.baseline_dir):
+            fail(f"--baseline-dir {args.baseline_dir}: no such folder")
+        todo += [c for c in baseline_cases(args, records, args.design_seed) if not families or c["family"] in families]
+    if args.limit:
+        todo = limited(todo, args.limit)
+    return records, todo
+
+
+def estimate(args, todo):
+    """(CPU seconds, wall minutes) the runs should take, from CPU_S_PER_RECORD_S."""
+    cpu = sum(CPU_S_PER_RECORD_S * (args.duration or c["duration_s"]) for c in todo)
+    return cpu, cpu / max(1, min(args.jobs, os.cpu_count() or 1)) / 60
+
+
+def json_entry(r):
+    c = r["case"]
+    return dict(family=c["family"], label=c["label"], device=c["device"], record=os.path.basename(c["record"]),
+                damaged=c["damaged"], loss=c["loss"], truth_damage_time_s=c["onset_s"], healthy_scales=c["healthy"],
+                masses_t=c["masses"], seed=c["seed"], duration_s=c["duration_s"], baseline=c.get("baseline"),
+                twin=r.get("twin"), steps=r.get("steps"), wall_time_s=r.get("wall"), error=r.get("error"))
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    records, todo = prepare(args)
+    cpu, minutes = estimate(args, todo)
+    count = collections.Counter(c["family"] for c in todo)
+    print(f"twin_benchmark.py: planned {len(todo)} runs ({', '.join(f'{n} {f}' for f, n in count.items())}; "
+          f"{sum(c['sct'] for c in todo)} on SCT); estimated {cpu / 60:.0f} CPU min, about {minutes:.0f} min "
+          f"on {args.jobs} jobs", file=sys.stderr, flush=True)
+    if args.plan:
+        for r in records:
+            print(f"{r['name']}: {r['length_s']:.1f} s, Arias 5/25/75/95 % at {r['t05']:.1f} / {r['t25']:.1f} / "
+                  f"{r['t75']:.1f} / {r['t95']:.1f} s, runs {r['duration_s']:.1f} s")
+        return 0
+    results, start = [], time.monotonic()
     with tempfile.TemporaryDirectory() as tmp, cf.ThreadPoolExecutor(max(1, args.jobs)) as pool:
         futures = [pool.submit(run, args, tmp, i, c) for i, c in enumerate(todo)]
         for n, f in enumerate(cf.as_completed(futures), 1):
             results.append(f.result())
             if n % 20 == 0 or n == len(todo):
-                print(f"twin_benchmark.py: {n}/{len(todo)} runs", file=sys.stderr, flush=True)
+                print(f"twin_benchmark.py: {n}/{len(todo)} runs, {(time.monotonic() - start) / 60:.1f} min",
+                      file=sys.stderr, flush=True)
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu_used = used.ru_utime + used.ru_stime
+    order = {id(c): i for i, c in enumerate(todo)}
+    simulated = sum(args.duration or r["case"]["duration_s"] for r in results if "twin" in r)
+    results.sort(key=lambda r: order[id(r["case"])])
     errors = [r for r in results if "error" in r]
-    for r in errors[:5]:
-        print(f"twin_benchmark.py: a run failed ({r['case'][0]}, {r['case'][1]}, "
-              f"{os.path.basename(r['case'][2])}): {r['error']}", file=sys.stderr)
     if args.json:
         with open(args.json, "w") as f:
-            json.dump([dict(label=r["case"][0], device=r["case"][1], record=os.path.basename(r["case"][2]),
-                            damaged=r["case"][4], loss=r["case"][5], seed=r["case"][6],
-                            twin=r.get("twin"), error=r.get("error")) for r in results], f)
-    print(f"twin benchmark: sensors {args.sensors} at 1 kHz, noise {args.noise_pct:g} % RMS, {len(records)} records, "
-          f"{len(results) - len(errors)} runs ({len(errors)} failed)")
-    if len(errors) == len(results):
-        return 1
-    table(results)
+            json.dump([json_entry(r) for r in results], f)
+    print(f"twin benchmark: sensors {args.sensors} at 1 kHz, noise {args.noise_pct:g} % RMS, {len(records)} records "
+          f"(each to max(40 s, Arias 95 % + 10 s)), healthy stories within {cc.HEALTHY_K_PCT:g} %, masses within "
+          f"{cc.MASS_PCT:g} %, {len(results)} runs ({len(errors)} failed), "
+          f"{(time.monotonic() - start) / 60:.1f} min on {args.jobs} jobs ({40 * cpu_used / max(1e-9, simulated):.2f} s "
+          f"CPU per 40 s of record run; estimated {40 * CPU_S_PER_RECORD_S:g}), design seed {args.design_seed}")
+    ct.print_all(results, args.bound)
     if args.calibrate:
-        worst = [max(1 - e for e in r["twin"]["eta_k"]) for r in results if "twin" in r]
-        worst.sort()
-        print(f"undamaged: largest final loss estimate of any story: median {statistics.median(worst):.4f}, "
-              f"p99 {worst[min(len(worst) - 1, int(0.99 * len(worst)))]:.4f}, max {worst[-1]:.4f}")
+        worst = sorted(max(1 - e for e in r["twin"]["eta_k"]) for r in results if "twin" in r)
+        if worst:
+            print(f"undamaged: largest final loss estimate of any story: median {statistics.median(worst):.4f}, "
+                  f"p99 {worst[min(len(worst) - 1, int(0.99 * len(worst)))]:.4f}, max {worst[-1]:.4f}")
     return 1 if errors else 0
 
 
