@@ -328,6 +328,9 @@ void add_hil(CLI::App& vines) {
       {"--twin-separation", {&tu.separation, "a story named: its statistic beyond the next story's by this"}},
       {"--twin-inflation", {&tu.inflation, "the estimate's covariance times this in the tests"}},
       {"--twin-drift-sd", {&tu.drift_sd, "a change test's model drift per story"}},
+      {"--twin-suspect", {&tu.suspect, "a change test's statistic beyond this restarts the losses' information..."}},
+      {"--twin-restart-gap", {&tu.restart_gap_s, "...at most once in this long [s]..."}},
+      {"--twin-restart-keep", {&tu.restart_keep, "...keeping this share of it"}},
       {"--twin-healthy-tolerance", {&tu.healthy_tolerance, "no baseline: the healthy stories within this of the drawing"}},
       {"--twin-mass-tolerance", {&tu.mass_tolerance, "no baseline: the floors' masses within this of the drawing"}},
   };

@@ -222,6 +222,9 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kInflation] = t.inflation;
   set[twin::kDriftVar] = t.drift_sd * t.drift_sd;
   set[twin::kSnapSteps] = std::max(1.0, std::round(t.snapshot_s / h));
+  set[twin::kSuspect] = t.suspect;
+  set[twin::kRestartSteps] = std::round(t.restart_gap_s / h);
+  set[twin::kRestartKeep] = std::min(1.0, t.restart_keep);
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);

@@ -36,13 +36,16 @@ struct TwinTuning {
   // the change tests' drift, and the model's error without a baseline
   // (healthy stories within 3 % of the drawing, masses within 2 %, each
   // uniform).
-  double threshold = 25;         // absolute test
-  double threshold_change = 25;  // change tests
+  double threshold = 12;         // absolute test
+  double threshold_change = 20;  // change tests
   double two_story = 10.8;       // a pair beyond the best story by this (chi-square 1 dof, 0.1 %)
   double separation = 4;         // a story named beyond the next by this
   double inflation = 4;          // the estimate's covariance times this
-  double drift_sd = 0.005;       // a change test's model drift per story
+  double drift_sd = 0.01;        // a change test's model drift per story
   double snapshot_s = 1.0;       // the change tests' snapshots
+  double suspect = 9;            // a change test's statistic beyond this restarts the information...
+  double restart_gap_s = 10;     // ...at most once in this long...
+  double restart_keep = 0.05;    // ...keeping this share of it
   double healthy_tolerance = 0.03;  // no baseline: the healthy stories within this of the drawing...
   double mass_tolerance = 0.02;     // ...and the floors' masses (uniform; twin_model_error.hpp)
   double innov_window_s = 2.0;   // the innovations' running mean square

@@ -39,6 +39,8 @@ struct DecisionSettings {
   S drift_var = S(0);         // a change test's model drift, variance per story
   long snap_steps = 1;        // steps between snapshots
   long hold_steps = 0;        // a candidate held this long raises the alarm
+  S suspect = S(0);           // a change test's statistic beyond this: the estimator restarts...
+  long restart_steps = 0;     // ...at most once in this many steps
 };
 
 template <typename S, int N>
@@ -51,7 +53,8 @@ class Decision {
   // base: the baseline's losses (n); sigma0: the model's covariance (n x n).
   void init(int n, const DecisionSettings<S>& s, const S* base, const S (*sigma0)[N]) {
     n_ = n, set_ = s, base_ = base, sigma0_ = sigma0;
-    count_ = 0, head_ = 0, lag_turn_ = 0, held_ = 0;
+    count_ = 0, head_ = 0, lag_turn_ = 0, held_ = 0, since_restart_ = s.restart_steps;
+    restart_ = false;
     detected_ = false, story_ = -1, second_ = -1, onset_ = -1;
     size_ = size2_ = S(0);
     for (auto& l : lag_) l.valid = false;
@@ -71,7 +74,7 @@ class Decision {
 
   // The absolute test on the losses with the estimate's covariance sig.
   void absolute(const S* loss, const S (&sig)[N][N]) {
-    S A[N][N], th[N];
+    S A[N][N], th[N] = {};
     for (int a = 0; a < n_; ++a) {
       th[a] = loss[a] - base_[a];
       for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * sig[a][b] + sigma0_[a][b];
@@ -90,7 +93,7 @@ class Decision {
     const int r = (head_ - 1 - kLag[i] + 2 * kRing) % kRing;
     const Snap& ref = ring_[r];
     const S rho = sdmax > S(0) ? (ref.sdmax / sdmax) * (ref.sdmax / sdmax) : S(1);
-    S A[N][N], th[N];
+    S A[N][N], th[N] = {};
     for (int a = 0; a < n_; ++a) {
       th[a] = loss[a] - ref.loss[a];
       for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * (S(1) + rho) * sig[a][b] + (a == b ? set_.drift_var : S(0));
@@ -114,6 +117,14 @@ class Decision {
     const Test& shown = best ? *best : abs_;
     for (int j = 0; j < n_; ++j) evidence_[j] = shown.valid ? shown.h.stat[j] : S(0);
     held_ = best ? held_ + elapsed : 0;
+    // A change suspected: the estimator restarts its information, so that
+    // it follows the changed building rather than a compromise between the
+    // building before and after (section 5).
+    since_restart_ += elapsed;
+    S change(0);
+    for (const Test& t : lag_) change = t.valid && t.h.one > change ? t.h.one : change;
+    if (change > set_.suspect && since_restart_ >= set_.restart_steps && !detected_)
+      restart_ = true, since_restart_ = 0, held_ = 0;
     if (!best || held_ < set_.hold_steps) return;
     detected_ = true;
     const Hypotheses<S, N>& h = best->h;
@@ -124,6 +135,14 @@ class Decision {
       second_ = -1, size_ = h.size[h.story], size2_ = S(0);
     }
     onset_ = onset(*best, h.story);
+  }
+
+  // Whether the estimator should restart its information now (once per
+  // suspicion: the call clears it).
+  bool take_restart() {
+    const bool r = restart_;
+    restart_ = false;
+    return r;
   }
 
   // ---- outputs -------------------------------------------------------------
@@ -190,8 +209,8 @@ class Decision {
   Snap ring_[kRing];
   int count_ = 0, head_ = 0, lag_turn_ = 0;
   Test abs_, lag_[kLags];
-  long held_ = 0, onset_ = -1;
-  bool detected_ = false;
+  long held_ = 0, onset_ = -1, since_restart_ = 0;
+  bool detected_ = false, restart_ = false;
   int story_ = -1, second_ = -1;
   S size_ = S(0), size2_ = S(0);
   S evidence_[N] = {};

@@ -278,6 +278,11 @@ class Estimator : public ImageDecoder<S, N> {
       dec_.change(loss_, sig_, sd_max());
     } else if (phase_ == 4) {
       dec_.decide(update_steps_);
+      if (dec_.take_restart()) {
+        const S keep = static_cast<S>(set_[kRestartKeep]);
+        for (int a = 0; a < d_.np; ++a)
+          for (int b = 0; b <= a; ++b) J_[a][b] *= keep;
+      }
     }
     phase_ = phase_ >= 4 || !factored_ ? 0 : phase_ + 1;
   }
@@ -296,6 +301,8 @@ class Estimator : public ImageDecoder<S, N> {
     c.drift_var = static_cast<S>(set_[kDriftVar]);
     c.snap_steps = static_cast<long>(set_[kSnapSteps]);
     c.hold_steps = hold_steps_;
+    c.suspect = static_cast<S>(set_[kSuspect]);
+    c.restart_steps = static_cast<long>(set_[kRestartSteps]);
     return c;
   }
 
