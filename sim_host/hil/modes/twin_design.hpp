@@ -37,10 +37,10 @@ struct TwinTuning {
   // (healthy stories within 3 % of the drawing, masses within 2 %, each
   // uniform).
   double threshold = 12;         // absolute test
-  double threshold_change = 20;  // change tests
+  double threshold_change = 25;  // change tests
   double two_story = 10.8;       // a pair beyond the best story by this (chi-square 1 dof, 0.1 %)
   double separation = 4;         // a story named beyond the next by this
-  double inflation = 4;          // the estimate's covariance times this
+  double inflation = 1;          // the estimate's covariance times this
   double drift_sd = 0.01;        // a change test's model drift per story
   double snapshot_s = 1.0;       // the change tests' snapshots
   double suspect = 9;            // a change test's statistic beyond this restarts the information...
