@@ -274,6 +274,26 @@ def test_tiny_real_run():
         assert (f"failed runs: {failed}" in p.stdout) == (failed > 0)
 
 
+def test_calibration_holds_the_statistic(tmp_path):
+    """tools/twin_calibrate.py: the largest one-story statistic held for 2 s (40 updates of
+    50 samples), not a one-update spike; its story."""
+    import twin_calibrate
+    path = tmp_path / "run.csv"
+    names = [f"stat_{j}" for j in range(1, 11)]
+    with open(path, "w") as f:
+        f.write(",".join(["k"] + names) + "\n")
+        for update in range(200):
+            stat = [0.5] * 10
+            if update == 10:
+                stat[1] = 100.0  # a spike: not held
+            if 50 <= update < 120:
+                stat[3] = 30.0 + (update == 80)  # held 3.5 s: 30
+            for k in range(50):
+                f.write(",".join([str(50 * update + k)] + [repr(v) for v in stat]) + "\n")
+    held, story = twin_calibrate.held_max(str(path))
+    assert held == 30.0 and story == 4
+
+
 if __name__ == "__main__":
     if len(sys.argv) > 1:
         os.environ["VINES_SOURCE_DIR"] = sys.argv[1]

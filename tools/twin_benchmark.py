@@ -19,7 +19,7 @@ error and share within 2 s, delay, false alarms with a 95 % Wilson interval, roo
 time per step, each figure beside its target (issue 52) with a pass/fail mark; the devices'
 health (VI NES impulse within 25 %, stuck sphere reported, never on a moving one; TMD detuned);
 the failed runs, counted and listed. With --calibrate, undamaged runs only and their largest
-final loss estimate. Options the tool does not know go to `vines hil` (e.g. --twin-loss-min).
+final loss estimate. Options the tool does not know go to `vines hil` (e.g. --twin-threshold).
 
 Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--quick] [--seeds N]
                          [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES]
