@@ -225,6 +225,7 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kSuspect] = t.suspect;
   set[twin::kRestartSteps] = std::round(t.restart_gap_s / h);
   set[twin::kRestartKeep] = std::min(1.0, t.restart_keep);
+  set[twin::kScoreForget] = std::exp(-set[twin::kUpdateSteps] * h / t.score_window_s);
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);

@@ -75,6 +75,7 @@ class TwinMode : public BenchMode {
     for (int j = 0; j < np; ++j) c.names.push_back("eta_sd_" + param_name(j));
     for (int j = 0; j < stories(); ++j) c.names.push_back("stat_" + param_name(j));
     c.names.push_back("stat_threshold");
+    c.names.push_back("change_score");
     c.names.push_back("alarm_story");
     Factors f(np);
     int alarm = 0;
@@ -88,6 +89,7 @@ class TwinMode : public BenchMode {
       row.insert(row.end(), f.stat.begin(), f.stat.begin() + stories());
       if (rec.got[i]) threshold = rec.tel[i].stat_threshold;
       row.push_back(threshold);
+      row.push_back(rec.got[i] ? rec.tel[i].change_score : 0.0);
       row.push_back(alarm);
       c.rows.push_back(std::move(row));
     }

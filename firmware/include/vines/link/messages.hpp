@@ -91,6 +91,7 @@ struct Telemetry {
   double est_stat = 0, stat_threshold = 0;
   std::uint8_t second_story = 0;
   double damage_size = 0, second_size = 0, onset_s = -1;
+  double change_score = 0;  // the estimator's change score (twin/estimator.hpp)
 };
 
 // The node's deadline monitor: every step's model work timed on the node's
@@ -208,6 +209,7 @@ void layout(IO& io, M& t, Telemetry*) {
   io.field(t.damage_size);
   io.field(t.second_size);
   io.field(t.onset_s);
+  io.field(t.change_score);
 }
 
 template <class IO, class M>

@@ -74,6 +74,7 @@ class TwinPlant {
     t->second_story = static_cast<std::uint8_t>(est_.second_story());
     t->damage_size = static_cast<double>(est_.damage_size());
     t->second_size = static_cast<double>(est_.second_size());
+    t->change_score = static_cast<double>(est_.change_score());
     t->onset_s = est_.onset_step() < 0 ? -1.0 : static_cast<double>(est_.onset_step()) * est_.period();
     if (est_.detected()) t->flags |= kDamage;
     if (est_.device_alarm()) t->flags |= kDeviceAlarm;

@@ -39,8 +39,7 @@ struct DecisionSettings {
   S drift_var = S(0);         // a change test's model drift, variance per story
   long snap_steps = 1;        // steps between snapshots
   long hold_steps = 0;        // a candidate held this long raises the alarm
-  S suspect = S(0);           // a change test's statistic beyond this: the estimator restarts...
-  long restart_steps = 0;     // ...at most once in this many steps
+  long restart_steps = 0;     // the estimator restarts at most once in this many steps
 };
 
 template <typename S, int N>
@@ -54,7 +53,7 @@ class Decision {
   void init(int n, const DecisionSettings<S>& s, const S* base, const S (*sigma0)[N]) {
     n_ = n, set_ = s, base_ = base, sigma0_ = sigma0;
     count_ = 0, head_ = 0, lag_turn_ = 0, held_ = 0, since_restart_ = s.restart_steps;
-    restart_ = false;
+    restart_ = false, suspected_ = false, now_ = 0, rise_ = -1;
     detected_ = false, story_ = -1, second_ = -1, onset_ = -1;
     size_ = size2_ = S(0);
     for (auto& l : lag_) l.valid = false;
@@ -104,7 +103,7 @@ class Decision {
   // After the tests: the strongest candidate, held, latched; its story (or
   // none identified), size, second story and onset. elapsed: steps since the
   // last decide().
-  void decide(long elapsed) {
+  void decide(long elapsed, bool suspected = false) {
     const Test* best = nullptr;
     S best_margin(0);
     auto consider = [&](const Test& t, S thr) {
@@ -117,14 +116,14 @@ class Decision {
     const Test& shown = best ? *best : abs_;
     for (int j = 0; j < n_; ++j) evidence_[j] = shown.valid ? shown.h.stat[j] : S(0);
     held_ = best ? held_ + elapsed : 0;
-    // A change suspected: the estimator restarts its information, so that
-    // it follows the changed building rather than a compromise between the
-    // building before and after (section 5).
+    // A change suspected (the estimator's score): it restarts its
+    // information, so that it follows the changed building rather than a
+    // compromise between the building before and after (section 5).
     since_restart_ += elapsed;
-    S change(0);
-    for (const Test& t : lag_) change = t.valid && t.h.one > change ? t.h.one : change;
-    if (change > set_.suspect && since_restart_ >= set_.restart_steps && !detected_)
-      restart_ = true, since_restart_ = 0, held_ = 0;
+    now_ += elapsed;
+    if (suspected && !suspected_) rise_ = now_;  // where the score rose: the change's onset
+    suspected_ = suspected;
+    if (suspected && since_restart_ >= set_.restart_steps && !detected_) restart_ = true, since_restart_ = 0;
     if (!best || held_ < set_.hold_steps) return;
     detected_ = true;
     const Hypotheses<S, N>& h = best->h;
@@ -134,7 +133,10 @@ class Decision {
       story_ = h.one - h.runner > set_.separation ? h.story : -1;
       second_ = -1, size_ = h.size[h.story], size2_ = S(0);
     }
-    onset_ = onset(*best, h.story);
+    // The onset: where the score last rose, if it did within the snapshots'
+    // span; else where the named story's change began in them.
+    const bool risen = rise_ >= 0 && now_ - rise_ <= static_cast<long>(kRing) * set_.snap_steps;
+    onset_ = risen ? rise_ : onset(*best, h.story);
   }
 
   // Whether the estimator should restart its information now (once per
@@ -209,8 +211,8 @@ class Decision {
   Snap ring_[kRing];
   int count_ = 0, head_ = 0, lag_turn_ = 0;
   Test abs_, lag_[kLags];
-  long held_ = 0, onset_ = -1, since_restart_ = 0;
-  bool detected_ = false, restart_ = false;
+  long held_ = 0, onset_ = -1, since_restart_ = 0, now_ = 0, rise_ = -1;
+  bool detected_ = false, restart_ = false, suspected_ = false;
   int story_ = -1, second_ = -1;
   S size_ = S(0), size2_ = S(0);
   S evidence_[N] = {};

@@ -41,7 +41,12 @@ class Estimator : public ImageDecoder<S, N> {
       for (int i = 0; i < kP; ++i) J_[j][i] = S(0);
     }
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
-    since_ = 0, k_ = 0, phase_ = 0;
+    since_ = 0, k_ = 0, phase_ = 0, score_ = S(0);
+    lam_update_ = static_cast<S>(std::pow(set_[kForget], static_cast<double>(update_steps_)));
+    for (int a = 0; a < kP; ++a) {
+      Gs_[a] = S(0);
+      for (int b = 0; b < kP; ++b) J0_[a][b] = Is_[a][b] = S(0);
+    }
     impact_left_ = 0;
     device_alarm_ = false;
     factored_ = false;
@@ -90,6 +95,7 @@ class Estimator : public ImageDecoder<S, N> {
   S evidence(int j) const { return dec_.evidence(j); }
   S evidence_threshold() const { return dec_.threshold(); }
   bool detected() const { return dec_.detected(); }
+  S change_score() const { return score_; }  // the score statistic (section 5)
   bool device_alarm() const { return device_alarm_; }
 
  private:
@@ -192,6 +198,16 @@ class Estimator : public ImageDecoder<S, N> {
   // Gauss-Newton step on the losses from the gradient since the last one.
   void solve() {
     const int np = d_.np;
+    // The score over the last seconds (section 5): the gradients and the
+    // information gathered since the last update, with their own forgetting.
+    const S ls = static_cast<S>(set_[kScoreForget]);
+    for (int a = 0; a < np; ++a) {
+      Gs_[a] = ls * Gs_[a] + g_[a];
+      for (int b = 0; b <= a; ++b) {
+        Is_[a][b] = ls * Is_[a][b] + (J_[a][b] - lam_update_ * J0_[a][b]);
+        J0_[a][b] = J_[a][b];
+      }
+    }
     factored_ = factor(F_);
     if (!factored_) return;
     const S(&F)[kP][kP] = F_;
@@ -272,19 +288,38 @@ class Estimator : public ImageDecoder<S, N> {
       inverse_from_factor(F_, d_.np, P);
       for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b) sig_[a][b] = P[a][b];
+      score_ = score();
     } else if (phase_ == 2) {
       dec_.absolute(loss_, sig_);
     } else if (phase_ == 3) {
       dec_.change(loss_, sig_, sd_max());
     } else if (phase_ == 4) {
-      dec_.decide(update_steps_);
+      dec_.decide(update_steps_, score_ > static_cast<S>(set_[kSuspect]));
       if (dec_.take_restart()) {
         const S keep = static_cast<S>(set_[kRestartKeep]);
         for (int a = 0; a < d_.np; ++a)
-          for (int b = 0; b <= a; ++b) J_[a][b] *= keep;
+          for (int b = 0; b <= a; ++b) J_[a][b] *= keep, J0_[a][b] *= keep;
       }
     }
     phase_ = phase_ >= 4 || !factored_ ? 0 : phase_ + 1;
+  }
+  // The score statistic Gs' Is^-1 Gs (a tenth of the prior's information
+  // added, for the first seconds): chi-square with np degrees of freedom
+  // while the model holds; a change makes the recent gradients agree.
+  S score() const {
+    const int np = d_.np;
+    S A[kP][kP], u[kP];
+    for (int a = 0; a < np; ++a)
+      for (int b = 0; b <= a; ++b) A[a][b] = Is_[a][b] + (a == b ? S(0.1) * prior_[a] : S(0));
+    if (!cholesky(A, np)) return S(0);
+    S t(0);
+    for (int a = 0; a < np; ++a) {
+      S v = Gs_[a];
+      for (int c = 0; c < a; ++c) v -= A[a][c] * u[c];
+      u[a] = v / A[a][a];
+      t += u[a] * u[a];
+    }
+    return t;
   }
   S sd_max() const {
     S m(0);
@@ -301,7 +336,6 @@ class Estimator : public ImageDecoder<S, N> {
     c.drift_var = static_cast<S>(set_[kDriftVar]);
     c.snap_steps = static_cast<long>(set_[kSnapSteps]);
     c.hold_steps = hold_steps_;
-    c.suspect = static_cast<S>(set_[kSuspect]);
     c.restart_steps = static_cast<long>(set_[kRestartSteps]);
     return c;
   }
@@ -315,6 +349,7 @@ class Estimator : public ImageDecoder<S, N> {
   bool device_alarm_ = false, factored_ = false;
   int phase_ = 0;
   S F_[kP][kP] = {}, sig_[N][N] = {};  // the last factor of J + prior; the stories' covariance
+  S J0_[kP][kP] = {}, Is_[kP][kP] = {}, Gs_[kP] = {}, score_ = S(0), lam_update_ = S(1);  // the score
   Decision<S, N> dec_;
 };
 

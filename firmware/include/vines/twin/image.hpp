@@ -69,9 +69,10 @@ enum TwinSetting : int {
   kInflation,     // the estimate's covariance times this in the tests
   kDriftVar,      // a change test's model drift, variance per story
   kSnapSteps,     // steps between the decision's snapshots
-  kSuspect,       // a change test's statistic beyond this restarts the information...
+  kSuspect,       // the score statistic beyond this restarts the information...
   kRestartSteps,  // ...at most once in this many steps...
   kRestartKeep,   // ...keeping this share of it
+  kScoreForget,   // the score's memory per update (exp(-update / window))
   kTwinSettings
 };
 
