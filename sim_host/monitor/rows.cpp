@@ -39,6 +39,15 @@ Series describe(const std::string& name, const std::string& mode, DeviceKind dev
   if (name == "aux" && mode == "twin") return {name, "top floor residual", "m/s^2", "residual"};
   if (name == "aux") return {name, "table command", "m", "floors"};
   if (name == "alarm_story") return {name, "story in alarm", "", "alarm"};
+  // The twin's decision: each story's statistic and the threshold (the
+  // evidence panel), the second story, the sizes and the onset (the banner).
+  if (name == "stat_threshold") return {name, "threshold", "", "evidence"};
+  if (name.size() > 5 && name.rfind("stat_", 0) == 0 && name.find_first_not_of("0123456789", 5) == std::string::npos)
+    return {name, "story " + name.substr(5), "", "evidence"};
+  if (name == "second_story") return {name, "second story", "", "decision"};
+  if (name == "damage_size") return {name, "damage size", "", "decision"};
+  if (name == "second_size") return {name, "second story's size", "", "decision"};
+  if (name == "onset_s") return {name, "onset", "s", "decision"};
   if (name == "table_x_m") return {name, "table", "m", "floors"};
   if (name == "force_measured_n") return {name, "load cell", "N", "force"};
   if (name == "tracking_rms_pct") return {name, "tracking error RMS so far", "%", "tracking"};
@@ -80,6 +89,16 @@ std::vector<std::string> series_names(const std::string& mode, const DeviceSerie
     for (const char* c : {"table_x_m", "aux", "force_measured_n", "tracking_rms_pct"}) names.push_back(c);
   }
   names.insert(names.end(), floors.begin(), floors.end());
+  return names;
+}
+
+std::vector<std::string> decision_names(const std::vector<std::string>& factors) {
+  std::vector<std::string> names;
+  if (factors.empty()) return names;
+  for (const std::string& f : factors)
+    if (f.find_first_not_of("0123456789", 4) == std::string::npos) names.push_back("stat_" + f.substr(4));
+  names.push_back("stat_threshold");
+  names.insert(names.end(), std::begin(kDecisionSeries), std::end(kDecisionSeries));
   return names;
 }
 
@@ -125,13 +144,15 @@ BenchRows::BenchRows(const Bench& b) : b_(b) {
     params_ = meta_.stories + (dev == DeviceKind::kNone ? 0 : 1);
     eta_.assign(static_cast<std::size_t>(params_), 1.0);
     sd_.assign(static_cast<std::size_t>(params_), 0.0);
+    stat_.assign(static_cast<std::size_t>(meta_.stories), 0.0);
     for (int j = 0; j < params_; ++j)
       factors.push_back("eta_" + (j < meta_.stories          ? std::to_string(j + 1)
                                   : dev == DeviceKind::kTmd ? std::string("tmd")
                                                             : std::string("device_floor_mass")));
   }
   for (int f : b.opt.floors) floors.push_back("x_" + std::to_string(f) + "_m");
-  const std::vector<std::string> names = series_names(meta_.mode, device_, factors, floors);
+  std::vector<std::string> names = series_names(meta_.mode, device_, factors, floors);
+  for (const std::string& n : decision_names(factors)) names.push_back(n);
   event_ = event_series(names, device_);
   for (const std::string& n : names) meta_.series.push_back(describe(n, meta_.mode, dev));
   if (dev != DeviceKind::kNone) set_device(b, &meta_);
@@ -142,6 +163,7 @@ void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) 
   const link::Telemetry& t = rec.tel[i];
   const int n = meta_.stories;
   if (t.est_index < eta_.size()) eta_[t.est_index] = t.est_eta, sd_[t.est_index] = t.est_sd;
+  if (t.est_index < stat_.size()) stat_[t.est_index] = t.est_stat;
   v->clear();
   v->push_back(rec.sensed[i]);
   v->push_back(t.x[n - 1]);
@@ -165,6 +187,11 @@ void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) 
     v->push_back(tracking_.pct());
   }
   for (int f : b_.opt.floors) v->push_back(t.x[f - 1]);
+  if (params_ > 0) {
+    v->insert(v->end(), stat_.begin(), stat_.end());
+    v->push_back(t.stat_threshold);
+    for (double x : {static_cast<double>(t.second_story), t.damage_size, t.second_size, t.onset_s}) v->push_back(x);
+  }
 }
 
 }  // namespace vines::host::monitor

@@ -64,6 +64,16 @@ DeviceSeries device_series(const std::string& mode, DeviceKind device, bool esti
 std::vector<std::string> series_names(const std::string& mode, const DeviceSeries& d,
                                       const std::vector<std::string>& factors, const std::vector<std::string>& floors);
 
+// The twin's decision, after series_names' (with the estimator: `factors`
+// not empty): each story's statistic in the decision's leading test (stat_1
+// ..., the evidence panel) and the absolute test's threshold
+// (stat_threshold), as the twin's --csv names them; then kDecisionSeries,
+// as the telemetry gives them (the banner: a second story, 0: none; the
+// sizes; the onset in s, -1: none), which the twin's --csv does not write
+// (yet): a replay shows them only from a CSV that has them.
+inline constexpr const char* kDecisionSeries[] = {"second_story", "damage_size", "second_size", "onset_s"};
+std::vector<std::string> decision_names(const std::vector<std::string>& factors);
+
 // The series whose nonzero value makes a sample an event the page keeps
 // (decimator.hpp): the model's contact force, where the node runs the VI
 // NES's model (not the twin estimator's force, which is never quite 0);
@@ -102,6 +112,7 @@ class BenchRows {
   int event_ = -1;                  // event_series
   int params_ = 0;                  // twin estimator: the factors (stories, then the device's)
   std::vector<double> eta_, sd_;    // each held from its last telemetry
+  std::vector<double> stat_;        // the stories' statistics, held the same way
   RunningTracking tracking_;
 };
 

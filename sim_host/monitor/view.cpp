@@ -98,6 +98,10 @@ void load_run(const std::string& path, Hub* hub) {
       floors.push_back(h);
   }
   std::vector<std::string> names = series_names(m.mode, ds, factors, floors);
+  // The decision's (a CSV of an earlier version has no statistics: the page
+  // says so; the twin's --csv has no sizes or onset).
+  if (col.count("alarm_story"))
+    for (const std::string& n : decision_names(factors)) names.push_back(n);
   // Those the file has (the tracking RMS: from the table and the top floor).
   names.erase(std::remove_if(names.begin(), names.end(),
                              [&](const std::string& n) { return n != "tracking_rms_pct" && !col.count(n); }),

@@ -1,14 +1,18 @@
 // The monitoring page in a real browser (sim_host/monitor/README.md): Debian's
 // headless chromium, driven over the DevTools protocol by puppeteer-core,
 // loads the page of `vines hil --serve` during a digital-twin run against a
-// damaged truth (story 3 at 90 %), and then `vines view` of the run's --csv.
+// damaged truth (story 3 at 90 %), and then `vines view` of the run's --csv
+// (and of the same CSV without its statistics, as an earlier version wrote it).
 // Checks: the page was live (data before the run ended); the values it
 // plotted are the run's (read back from the page, against the --csv, bit for
 // bit where the CSV is exact); every kept sample is there; the alarm names
 // story 3 when the report does, at the sample it came; the replay equals the
 // live page; in hybrid mode the table's tracking RMS is the report's; in
 // replay the device panel's box (the sphere against its walls); on an
-// undamaged building, no alarm. Saves screenshots.
+// undamaged building, no alarm; the twin's evidence panel draws the CSV's
+// last statistics against the threshold, the named story highlighted; every
+// chart fills its panel's width (1280 x 900 and 1920 x 1080). Saves
+// screenshots.
 //
 //   node page_test.js VINES SOURCE_DIR OUT_DIR
 "use strict";
@@ -64,19 +68,87 @@ const pageData = (page) =>
   page.evaluate(() => {
     const p = window.vinesPage;
     return { meta: p.meta, k: p.k, data: p.data, derived: p.derived, alarms: p.alarms, report: p.report, ended: p.ended,
+             evidence: p.evidence, factors: p.factors,
              banner: document.getElementById("alarm").textContent,
              bannerClass: document.getElementById("alarm").className,
              legend: Array.from(document.querySelectorAll(".u-legend .u-series")).map((e) => e.textContent) };
   });
 
+// The decision's series the telemetry gives and the twin's --csv does not
+// write (sim_host/monitor/rows.hpp: kDecisionSeries): checked against the report.
+const DECISION_ONLY = ["second_story", "damage_size", "second_size", "onset_s"];
+
+// Each chart's canvas against its panel: the widest canvas's share of the
+// panel's width (uPlot's or the bar charts').
+const chartWidths = (page) =>
+  page.evaluate(() => Array.from(document.querySelectorAll("#charts .panel")).map((p) => {
+    const w = Math.max(0, ...Array.from(p.querySelectorAll("canvas")).map((c) => c.getBoundingClientRect().width));
+    return { panel: p.dataset.panel, share: w / p.getBoundingClientRect().width, canvases: p.querySelectorAll("canvas").length };
+  }));
+
+// At a window size: every panel's chart at least 95 % of its panel's width
+// (the evidence panel of a CSV without statistics has none); a screenshot.
+async function fillsPanels(page, width, height, shot, what) {
+  await page.setViewport({ width, height });
+  await new Promise((r) => setTimeout(r, 600));  // the resize, a redraw
+  const widths = chartWidths(page);
+  const got = await widths;
+  const narrow = got.filter((c) => c.canvases > 0 && c.share < 0.95);
+  check(got.length > 0 && narrow.length === 0,
+    `${what} at ${width}x${height}: charts narrower than 95 % of their panels: ${JSON.stringify(narrow)}`);
+  await page.screenshot({ path: path.join(out, shot), fullPage: true });
+  return Math.min(...got.filter((c) => c.canvases > 0).map((c) => c.share));
+}
+
+// The evidence panel against the CSV at the page's last sample: each bar the
+// story's statistic (rel. 1e-8: the CSV's 9 digits), its top where the
+// asinh scale puts it, the threshold line at the threshold, the named story
+// (and only it) in the highlight colour, read back from the canvas's pixels.
+async function evidenceMatches(page, live, cols, what) {
+  const ev = live.evidence, n = live.meta.stories, k = live.k[live.k.length - 1];
+  if (!check(ev && !ev.none && ev.stat.length === n, `${what}: no evidence panel (${JSON.stringify(ev)})`)) return;
+  check(ev.k === k, `${what}: the evidence is of sample ${ev.k}, the page's last is ${k}`);
+  let worst = 0;
+  for (let j = 1; j <= n; ++j) {
+    const want = cols[`stat_${j}`][k], got = ev.stat[j - 1];
+    worst = Math.max(worst, Math.abs(got - want) / Math.max(1, Math.abs(want)));
+  }
+  check(worst <= 1e-8, `${what}: the bars off the CSV's statistics by ${worst}`);
+  check(ev.threshold === cols.stat_threshold[k], `${what}: threshold ${ev.threshold}, CSV ${cols.stat_threshold[k]}`);
+  const p = ev.plot, y = (v) => p.bottom - (Math.asinh(Math.max(0, v)) / Math.asinh(ev.top)) * (p.bottom - p.top);
+  const off = Math.max(...ev.bars.map((b) => Math.abs(b.y - y(b.value)) + Math.abs(b.y + b.h - p.bottom)));
+  check(off < 0.5, `${what}: a bar ${off} px off its value on the asinh scale`);
+  check(Math.abs(ev.thresholdY - y(ev.threshold)) <= 0.5, `${what}: the threshold line at ${ev.thresholdY}, ${y(ev.threshold)} wanted`);
+  check(ev.named === cols.alarm_story[k], `${what}: named ${ev.named}, CSV's alarm_story ${cols.alarm_story[k]}`);
+  // The pixels: in each bar (clear of the threshold line and the labels), and
+  // on the threshold line right of the last bar.
+  const px = await page.evaluate((ev) => {
+    const c = document.querySelector('[data-panel="evidence"] canvas'), dpr = c.width / c.getBoundingClientRect().width;
+    const at = (x, y) => Array.from(c.getContext("2d").getImageData(Math.round(x * dpr), Math.round(y * dpr), 1, 1).data.slice(0, 3));
+    const inBar = (b) => {
+      let yy = b.y + b.h * 0.75;
+      if (Math.abs(yy - ev.thresholdY) < 4) yy = b.y + b.h * 0.35;
+      return b.h >= 8 ? at(b.x + b.w / 2, yy) : null;
+    };
+    return { bars: ev.bars.map(inBar), line: at(ev.plot.right - 2, ev.thresholdY) };
+  }, ev);
+  const hex = (rgb) => "#" + rgb.map((v) => v.toString(16).padStart(2, "0")).join("");
+  const red = px.bars.map((c, j) => (c && hex(c) === "#c9302c" ? j + 1 : 0)).filter((j) => j);
+  const drawn = ev.bars.filter((b) => b.h >= 8).map((b) => b.story);
+  check(JSON.stringify(red) === JSON.stringify(ev.named && drawn.includes(ev.named) ? [ev.named] : []),
+    `${what}: bars in the highlight colour ${JSON.stringify(red)}, named ${ev.named}`);
+  check(hex(px.line) === "#000000", `${what}: the threshold line's pixel ${hex(px.line)}`);
+  return { k, stat: ev.stat, threshold: ev.threshold, named: ev.named, highlighted: red };
+}
+
 async function main() {
   const csv = path.join(out, "twin.csv");
   const run = start(["hil", "data/scenes/elcentro_vines.toml", "--mode", "twin", "--truth",
     "data/scenes/twin/truth_story3_loss10.toml", "--sensors", "3,6,8,10", "--measure-noise-pct", "5",
-    "--floors", "3,6", "--realtime", "--grace", "100", "--duration", "10", "--serve", "0", "--csv", csv, "--json"]);
+    "--floors", "3,6", "--realtime", "--grace", "100", "--duration", "16", "--serve", "0", "--csv", csv, "--json"]);
   const url = await run.url;
   const browser = await puppeteer.launch({ executablePath: chromium, headless: true,
-    args: ["--no-sandbox", "--disable-gpu", "--window-size=1280,1400"], defaultViewport: { width: 1240, height: 1300 } });
+    args: ["--no-sandbox", "--disable-gpu", "--window-size=1920,1080"], defaultViewport: { width: 1280, height: 900 } });
   try {
     const page = await browser.newPage();
     const errors = [];
@@ -88,8 +160,9 @@ async function main() {
     check(!during.ended, "the page got its data only after the run ended");
     await page.waitForFunction(() => window.vinesPage.ended, { timeout: 120000 });
     await new Promise((r) => setTimeout(r, 300));  // a last redraw
-    const live = await pageData(page);
-    await page.screenshot({ path: path.join(out, "monitor_twin.png"), fullPage: true });
+    const share = [await fillsPanels(page, 1920, 1080, "monitor_twin_1920.png", "live"),
+                   await fillsPanels(page, 1280, 900, "monitor_twin.png", "live")];
+    const live = await pageData(page);  // as drawn at 1280 x 900
     check(errors.length === 0, "page errors: " + errors.join("; "));
     const exit = await run.exited;
     check(exit.code === 0, `vines hil exit ${exit.code}: ${run.stderrText}`);
@@ -106,6 +179,7 @@ async function main() {
     const exact = ["ag_sent_mps2", "x_top_m", "x_3_m", "x_6_m", "contact_force_n", "flags", "aux", "alarm_story"];
     let compared = 0;
     for (const s of live.meta.series) {
+      if (DECISION_ONLY.includes(s.name)) continue;
       const tol = exact.includes(s.name) ? 0 : 1e-8;
       const got = live.data[s.name], want = cols[s.name];
       if (!check(want !== undefined, `series ${s.name} not in the CSV`)) continue;
@@ -117,7 +191,9 @@ async function main() {
       check(worst <= tol, `${s.name}: page against CSV off by ${worst} (allowed ${tol})`);
       compared += got.length;
     }
-    check(live.meta.series.length === 32, `${live.meta.series.length} series (32: 10 stories and the device with sd, floors 3, 6)`);
+    check(live.meta.series.length === 47, `${live.meta.series.length} series (47: 10 stories and the device with sd, ` +
+      "10 statistics and the threshold, the decision's 4, floors 3, 6)");
+    const ev = await evidenceMatches(page, live, cols, "live");
     // The alarm: the report's story, on the banner, from the sample it came.
     const tw = report.twin;
     check(tw.detected && tw.story === 3, `report: detected ${tw.detected}, story ${tw.story}`);
@@ -129,9 +205,21 @@ async function main() {
       check(Math.abs(first.t - tw.detect_time_s) <= every / 1000, `alarm at ${first.t} s, report ${tw.detect_time_s} s`);
     }
     check(live.report && live.report.twin.story === 3 && live.report.steps === report.steps, "the page's report");
+    // The decision's sizes and onset (not in the CSV) at the last sample: the report's, on the banner.
+    const last = live.k.length - 1, pct = (v) => `${(100 * v).toFixed(1)} %`;
+    check(live.k[last] === report.samples - 1, `the page's last sample ${live.k[last]}, of ${report.samples}`);
+    check(live.data.damage_size[last] === tw.size && live.data.second_story[last] === 0 &&
+          live.data.onset_s[last] === (tw.onset_s === null ? -1 : tw.onset_s),
+      `the decision on the page: size ${live.data.damage_size[last]}, onset ${live.data.onset_s[last]}; report ${tw.size}, ${tw.onset_s}`);
+    check(live.banner.includes(`loss ${pct(tw.size)}`) && (tw.onset_s === null || live.banner.includes(`onset ${tw.onset_s.toFixed(2)} s`)),
+      `banner "${live.banner}": not the report's size ${pct(tw.size)} and onset ${tw.onset_s}`);
     console.log(`live: ${live.k.length} samples x ${live.meta.series.length} series (${compared} values) equal ` +
       `to the CSV; alarm story 3 at ${first && first.t} s (report ${tw.detect_time_s} s); ` +
       `deadline misses ${report.deadline_misses}, latency p99 ${report.latency_us.p99.toFixed(1)} us`);
+    if (ev)
+      console.log(`live evidence at k ${ev.k}: statistics [${ev.stat.map((v) => v.toPrecision(3)).join(", ")}] equal to the ` +
+        `CSV's, threshold ${ev.threshold}, story ${ev.named} highlighted (${JSON.stringify(ev.highlighted)}); banner ` +
+        `"${live.banner}"; charts at least ${(100 * Math.min(...share)).toFixed(1)} % of their panels' width`);
 
     // The replay of the run's --csv: the same page.
     const view = start(["view", csv, "--serve", "0"]);
@@ -141,17 +229,30 @@ async function main() {
     const replay = await pageData(page2);
     check(JSON.stringify(replay.k) === JSON.stringify(live.k), "view: other samples than live");
     for (const s of live.meta.series) {
+      if (DECISION_ONLY.includes(s.name)) continue;
       const a = live.data[s.name], b = replay.data[s.name] || [];
       const tol = exact.includes(s.name) ? 0 : 1e-8;
       const worst = a.reduce((w, v, i) => Math.max(w, Math.abs(v - b[i]) / Math.max(1, Math.abs(v))), 0);
       check(b.length === a.length && worst <= tol, `view: ${s.name} off the live page by ${worst}`);
     }
     check(/damage: story 3/.test(replay.banner), `view banner "${replay.banner}"`);
-    await page2.screenshot({ path: path.join(out, "monitor_view.png"), fullPage: true });
+    await new Promise((r) => setTimeout(r, 300));  // a last redraw
+    const replayNow = await pageData(page2);
+    const rev = await evidenceMatches(page2, replayNow, cols, "view");
+    // The same bars as live (the CSV's 9 digits against the telemetry's: within 0.01 px), the same colours.
+    const rb = (replayNow.evidence && replayNow.evidence.bars) || [], lb = live.evidence.bars;
+    check(rev && ev && rb.length === lb.length && rb.every((b, j) => b.fill === lb[j].fill && b.x === lb[j].x &&
+          Math.abs(b.y - lb[j].y) < 0.01 && Math.abs(b.h - lb[j].h) < 0.01) &&
+          replayNow.evidence.thresholdY === live.evidence.thresholdY,
+      "view: the evidence panel drawn otherwise than live");
+    check(replayNow.factors && replayNow.factors.eta.every((v, j) => Math.abs(v - live.factors.eta[j]) <= 1e-8),
+      "view: other factors now than live");
+    await fillsPanels(page2, 1280, 900, "monitor_view.png", "view");
     view.kill("SIGINT");
     const vexit = await view.exited;
     check(vexit.code === 0, `vines view exit ${vexit.code} ${vexit.signal} on Ctrl-C`);
-    console.log(`view: ${replay.k.length} samples equal to the live page; screenshots in ${out}`);
+    console.log(`view: ${replay.k.length} samples equal to the live page, the same evidence bars; screenshots in ${out}`);
+    await olderCsv(browser, csv, replayNow);
     await hybrid(browser);
     await deviceBox(browser);
     await noFalseAlarm(browser);
@@ -159,6 +260,33 @@ async function main() {
     await browser.close();
     run.kill();
   }
+}
+
+// A twin CSV of an earlier version (no stat_ columns): `vines view` shows it,
+// the evidence panel saying it has no statistics, the factors as the newer CSV's.
+async function olderCsv(browser, csv, replay) {
+  const lines = fs.readFileSync(csv, "utf8").trim().split("\n");
+  const keep = lines[0].split(",").map((n, j) => (/^stat_/.test(n) ? -1 : j)).filter((j) => j >= 0);
+  const old = path.join(out, "twin_no_stats.csv");
+  fs.writeFileSync(old, lines.map((l) => { const c = l.split(","); return keep.map((j) => c[j]).join(","); }).join("\n") + "\n");
+  const view = start(["view", old, "--serve", "0"]);
+  const page = await browser.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  await page.goto(await view.url);
+  await page.waitForFunction(() => window.vinesPage.ended, { timeout: 60000 });
+  await new Promise((r) => setTimeout(r, 300));
+  const got = await pageData(page);
+  const text = await page.$eval('[data-panel="evidence"]', (e) => e.textContent).catch(() => "");
+  check(errors.length === 0, "older CSV: page errors: " + errors.join("; "));
+  check(got.evidence && got.evidence.none && /no statistics/.test(text), `older CSV: evidence panel "${text}"`);
+  check(!got.meta.series.some((s) => /^stat_/.test(s.name)), "older CSV: statistics on the page");
+  check(JSON.stringify(got.factors.eta) === JSON.stringify(replay.factors ? replay.factors.eta : null) &&
+        /damage: story 3/.test(got.banner), `older CSV: factors or banner ("${got.banner}") not the newer CSV's`);
+  await fillsPanels(page, 1280, 900, "monitor_view_no_stats.png", "older CSV");
+  view.kill("SIGINT");
+  await view.exited;
+  console.log(`older CSV (no statistics): shown, the evidence panel says "${text.replace(/^.*?(no statistics[^;]*).*$/, "$1")}"`);
 }
 
 // Hybrid mode (the TMD on the table, 4 s in real time): the table, its
