@@ -76,10 +76,12 @@ class TwinMode : public BenchMode {
     for (int j = 0; j < stories(); ++j) c.names.push_back("stat_" + param_name(j));
     c.names.push_back("stat_threshold");
     c.names.push_back("change_score");
+    for (const char* name : {"second_story", "damage_size", "second_size", "onset_s"}) c.names.push_back(name);
     c.names.push_back("alarm_story");
     Factors f(np);
     int alarm = 0;
     double threshold = 0;
+    std::vector<double> decision = {0.0, 0.0, 0.0, -1.0};  // second story, sizes, onset (held)
     for (long long k = 0; k < rec.samples; ++k) {
       const auto i = static_cast<std::size_t>(k);
       if (rec.got[i]) f.take(rec.tel[i]), alarm = rec.tel[i].alarm_story;
@@ -89,7 +91,10 @@ class TwinMode : public BenchMode {
       row.insert(row.end(), f.stat.begin(), f.stat.begin() + stories());
       if (rec.got[i]) threshold = rec.tel[i].stat_threshold;
       row.push_back(threshold);
+      if (rec.got[i]) decision = {static_cast<double>(rec.tel[i].second_story), rec.tel[i].damage_size,
+                                  rec.tel[i].second_size, rec.tel[i].onset_s};
       row.push_back(rec.got[i] ? rec.tel[i].change_score : 0.0);
+      row.insert(row.end(), decision.begin(), decision.end());
       row.push_back(alarm);
       c.rows.push_back(std::move(row));
     }
