@@ -205,7 +205,18 @@ TEST(Messages, RoundTripBitForBit) {
   t.drift_alarms = 1ull << 39;
   t.comp[0] = 1.01, t.comp[1] = 0.0166, t.comp[2] = 1.4e-4;
   t.est_index = 40, t.alarm_story = 3, t.est_eta = 0.9, t.est_sd = 0.01;
+  t.est_stat = 123.5, t.stat_threshold = 12, t.second_story = 7, t.damage_size = 0.0987, t.second_size = 0.05;
+  t.onset_s = 15.25, t.change_score = 61.5;
+  std::uint8_t telemetry_payload[kMaxPayload];
+  EXPECT_EQ(encode(t, telemetry_payload, sizeof telemetry_payload), 499u);  // 40 stories: the largest
   const Telemetry t2 = round_trip(t);
+  EXPECT_EQ(t2.est_stat, 123.5);
+  EXPECT_EQ(t2.stat_threshold, 12.0);
+  EXPECT_EQ(t2.second_story, 7);
+  EXPECT_EQ(t2.damage_size, 0.0987);
+  EXPECT_EQ(t2.second_size, 0.05);
+  EXPECT_EQ(t2.onset_s, 15.25);
+  EXPECT_EQ(t2.change_score, 61.5);
   EXPECT_EQ(t2.est_index, 40);
   EXPECT_EQ(t2.alarm_story, 3);
   EXPECT_EQ(t2.est_eta, 0.9);

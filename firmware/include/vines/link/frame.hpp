@@ -17,7 +17,7 @@ namespace vines::link {
 
 inline constexpr std::uint8_t kProtocolVersion = 5;
 inline constexpr std::size_t kHeaderBytes = 4, kCrcBytes = 4;
-inline constexpr std::size_t kMaxPayload = 480;
+inline constexpr std::size_t kMaxPayload = 512;  // a 40-story twin TELEMETRY is 499
 inline constexpr std::size_t kMaxRaw = kHeaderBytes + kMaxPayload + kCrcBytes;
 // Encoded frame with its delimiter: what a sender's buffer must hold.
 inline constexpr std::size_t kMaxWire = cobs_max_encoded(kMaxRaw) + 1;
