@@ -7,8 +7,8 @@
 // their error:
 // - absolute: the losses less the baseline's (the factors a commissioning
 //   run on the healthy building identified; none: nominal), with the error
-//   the estimate's own (its information, inflated by a calibrated factor
-//   for the innovations' colour) plus the model's (the baseline's
+//   the estimate's own (its information, times an inflation factor, 1 by
+//   calibration) plus the model's (the baseline's
 //   covariance, or the healthy stories' and masses' spread about the
 //   drawing);
 // - change: the losses now less the losses some seconds ago (a ring of
@@ -19,7 +19,8 @@
 // story's by the separation ("damage, story not identified" otherwise), two
 // stories when the pair beats the best one by the two-story margin. A
 // candidate held for the hold time raises the alarm, which latches. The onset
-// is where the named story's change began in the snapshots.
+// is where the estimator's change score last rose, or else where the named
+// story's change began in the snapshots.
 #pragma once
 
 #include <cmath>
