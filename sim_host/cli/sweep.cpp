@@ -24,9 +24,6 @@
 namespace vines::cli {
 namespace {
 
-// Plans above this many runs need --large.
-constexpr std::uint64_t kLargePlan = 1000000;
-
 struct SweepArgs {
   std::string spec_path, resume_dir;
   bool large = false;
@@ -214,7 +211,7 @@ void add_sweep(CLI::App& vines) {
                ->check(non_empty_path());
   cmd->add_option("--threads", a->opt.threads, "worker threads (default: all cores; per rank under MPI)")
       ->type_name("N")
-      ->check(number_in(1, 1024));
+      ->check(number_in(1, host::kMaxThreads));
   cmd->add_option("--resume", a->resume_dir,
                   "finish the sweep of this spec in DIR (its DIR/runs.jsonl): run only the runs not finished")
       ->type_name("DIR")

@@ -214,10 +214,30 @@ struct PyLoop {
   int stories = 0;
   bool ledger = false;  // loop.energy_ledger: totals has the balance's residual
   bool started = false;
+  // run() stepping in another thread, the GIL released (set and read with
+  // the GIL held): every call refused meanwhile, so that two threads never
+  // step one building's state at once.
+  bool busy = false;
 
+  void require_free() const {
+    if (busy)
+      throw std::runtime_error(
+          "vines.Loop: this loop is running samples in another thread; a Loop is one building's state, stepped "
+          "by one thread at a time: give each thread its own (copy.deepcopy(loop))");
+  }
   void require_started() const {
+    require_free();
     if (!started) throw std::runtime_error("vines.Loop: reset(a0) first (the ground acceleration at t = 0)");
   }
+};
+
+// Marks a loop busy while run() steps it with the GIL released.
+struct Busy {
+  explicit Busy(PyLoop& l) : loop(l) { loop.busy = true; }
+  ~Busy() { loop.busy = false; }
+  Busy(const Busy&) = delete;
+  Busy& operator=(const Busy&) = delete;
+  PyLoop& loop;
 };
 
 PyLoop make_loop(const PyScene& s) {
@@ -300,6 +320,7 @@ PYBIND11_MODULE(_vines, m) {
   py::class_<PyLoop>(m, "Loop")
       .def(py::init(&make_loop), py::arg("scene"))
       .def("reset", [](PyLoop& l, double a0) {
+        l.require_free();
         l.eng->init(a0);
         l.started = true;
         return step_dict(l.eng->snapshot(), l.stories);
@@ -313,6 +334,7 @@ PYBIND11_MODULE(_vines, m) {
         l.require_started();
         if (a.ndim() != 1) throw std::invalid_argument("vines.Loop.run: the samples must be one-dimensional");
         {
+          const Busy busy(l);
           py::gil_scoped_release release;
           l.eng->run(a.data(), static_cast<std::size_t>(a.shape(0)));
         }
@@ -329,6 +351,7 @@ PYBIND11_MODULE(_vines, m) {
         return py::bytes(reinterpret_cast<const char*>(b.data()), b.size());
       })
       .def("load_state", [](PyLoop& l, const py::bytes& b) {
+        l.require_free();
         const std::string data = b;
         const std::string why = l.eng->load_state(reinterpret_cast<const std::uint8_t*>(data.data()), data.size());
         if (!why.empty()) throw std::invalid_argument("vines.Loop.set_state: " + why);
@@ -370,5 +393,5 @@ PYBIND11_MODULE(_vines, m) {
   m.def("samples", &samples, py::arg("scene"), py::arg("record") = nullptr);
   m.def("modal", &modal, py::arg("scene"));
   m.def("sweep", &sweep, py::arg("scene"), py::arg("grid"), py::arg("set"), py::arg("cases"), py::arg("group_by"),
-        py::arg("threads"));
+        py::arg("threads"), py::arg("large"));
 }

@@ -37,9 +37,10 @@ void insert(toml::table& t, const std::string& name, const py::handle v, const s
 // A study of the scene as `vines sweep` runs one: grid (a key's list of
 // values, or {from, to, step | count, scale}, as in [study.grid]), set (fixed
 // keys), cases (a list of dicts of paired keys), on `threads` threads (0: all
-// cores) with the GIL released. Returns each run's keys and results, in the
-// order of the spec's plan (results.csv's rows).
+// cores; at most kMaxThreads) with the GIL released; a plan above kLargePlan
+// runs only with `large`. Returns each run's keys and results, in the order
+// of the spec's plan (results.csv's rows).
 py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, const py::list& cases,
-               const std::string& group_by, int threads);
+               const std::string& group_by, int threads, bool large);
 
 }  // namespace vines::python

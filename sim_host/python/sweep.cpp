@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "sim_host/python/module.hpp"
 #include "sim_host/studies/sweep.hpp"
 
@@ -19,8 +21,11 @@ namespace vines::python {
 using namespace vines::host;
 
 py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, const py::list& cases,
-               const std::string& group_by, int threads) {
+               const std::string& group_by, int threads, bool large) {
   const std::string origin = s.origin + " (sweep)";
+  if (threads < 0 || threads > kMaxThreads)
+    throw std::invalid_argument("vines.sweep: threads: " + std::to_string(threads) + "; must be 0 (every core) to " +
+                                std::to_string(kMaxThreads));
   toml::table study;
   study.insert("name", "python");
   study.insert("scene", "scene.toml");  // the study's scene is s, set below
@@ -44,6 +49,19 @@ py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, cons
     std::ostringstream scene;
     scene << s.table;
     spec.studies[0].scene_toml = scene.str();
+    // As `vines sweep` does: a plan above kLargePlan runs needs large=True
+    // (its plan alone takes gigabytes before any run), and one that would
+    // take more than half the machine's memory is refused whatever.
+    const std::uint64_t n = plan_size(spec);
+    if (n > kLargePlan) {
+      const double gb = static_cast<double>(n) * (sizeof(RunPlan) + sizeof(RunResult)) / 1e9;
+      const double ram = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+      std::ostringstream why;
+      why << origin << ": the plan has " << n << " runs (more than " << kLargePlan << ") and needs about "
+          << static_cast<double>(static_cast<long long>(gb * 10)) / 10 << " GB of memory";
+      if (gb * 1e9 > ram / 2) throw std::invalid_argument(why.str() + ", more than half of this machine's: split the grid");
+      if (!large) throw std::invalid_argument(why.str() + ": pass large=True to run it");
+    }
     plan = plan_runs(spec);
   } catch (const SceneError&) {
     throw;

@@ -32,6 +32,12 @@
 
 namespace vines::host {
 
+// Plans above this many runs need --large (Python: large=True): the plan
+// alone takes gigabytes before any run.
+constexpr std::uint64_t kLargePlan = 1000000;
+// The most threads a sweep takes (--threads; Python's threads).
+constexpr int kMaxThreads = 1024;
+
 struct SweepOptions {
   std::string out_dir;  // "" = out/<spec stem>
   int threads = 0;      // 0 = all cores

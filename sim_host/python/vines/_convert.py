@@ -32,6 +32,34 @@ def _number(value: Any, where: str) -> Plain:
     raise TypeError("%s: a value of type %s (%s)" % (where, type(value).__name__, _EXPECTED))
 
 
+def real(value: Any, where: str, finite: bool = False) -> float:
+    """A number argument as a float: a TypeError for another type (bool, str,
+    None...), a ValueError for an int too large for a double or, with
+    `finite`, a NaN or infinity; each naming `where`."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
+        raise TypeError("%s: a number (int or float), not %s" % (where, type(value).__name__))
+    try:
+        f = float(value)
+    except OverflowError:
+        raise ValueError("%s: %r does not fit a double" % (where, value)) from None
+    if finite and not math.isfinite(f):
+        raise ValueError("%s: %r is not finite" % (where, value))
+    return f
+
+
+def samples_array(value: Any, where: str) -> "np.ndarray[Any, np.dtype[np.float64]]":
+    """An array of samples as float64: a TypeError for a masked array (its
+    mask would be dropped) and for kinds that are not numbers (bool, str,
+    object, complex), naming `where`."""
+    if isinstance(value, np.ma.MaskedArray):
+        raise TypeError("%s: a masked array (its mask would be lost): fill or drop the masked samples first "
+                        "(numpy.ma.filled, .compressed)" % where)
+    a = np.asarray(value)
+    if a.dtype.kind not in "iuf":
+        raise TypeError("%s: numbers (an array of int or float), not %s" % (where, a.dtype))
+    return a.astype(float)
+
+
 def plain(value: Any, where: str) -> Plain:
     """`value` as bool, int, float, str, list or dict (nested), exactly:
     numpy scalars become Python numbers, arrays and tuples lists, mappings

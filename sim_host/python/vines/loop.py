@@ -9,6 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _vines
+from ._convert import real, samples_array
 from .result import blank_absent
 from .scene import Scene, as_scene
 
@@ -119,7 +120,7 @@ class Loop:
         Step
             The outputs at t = 0.
         """
-        return self._step(self._impl.reset(float(a0)))
+        return self._step(self._impl.reset(real(a0, "vines.Loop.reset: a0")))
 
     def step(self, a_g: float) -> Step:
         """One sensor period on.
@@ -140,7 +141,7 @@ class Loop:
         RuntimeError
             Before `reset` (or `set_state` with a saved state).
         """
-        return self._step(self._impl.step(float(a_g)))
+        return self._step(self._impl.step(real(a_g, "vines.Loop.step: a_g")))
 
     def run(self, samples: npt.ArrayLike) -> Step:
         """Steps through many samples, the loop in C++ with the GIL released.
@@ -155,7 +156,7 @@ class Loop:
         Step
             The last step's outputs.
         """
-        return self._step(self._impl.run(np.asarray(samples, dtype=float)))
+        return self._step(self._impl.run(samples_array(samples, "vines.Loop.run: samples")))
 
     @property
     def state(self) -> LoopState:

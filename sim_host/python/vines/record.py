@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _vines
-from ._convert import PathLike, path_of
+from ._convert import PathLike, path_of, real, samples_array
 
 
 class Record:
@@ -44,10 +44,9 @@ class Record:
 
     def __init__(self, acc: npt.ArrayLike, dt: float, units: str = "g", t0: float = 0.0,
                  name: str = "<array>") -> None:
-        samples = np.asarray(acc)
-        if samples.dtype.kind not in "biuf":
-            raise TypeError("vines.Record: acc: numbers (an array of int or float), not %s" % samples.dtype)
-        self._impl = _vines.Record.from_array(samples.astype(float), float(dt), float(t0), str(units), str(name))
+        samples = samples_array(acc, "vines.Record: acc")
+        self._impl = _vines.Record.from_array(samples, real(dt, "vines.Record: dt", finite=True),
+                                              real(t0, "vines.Record: t0", finite=True), str(units), str(name))
         self._args: Tuple[Any, ...] = ("array",)
 
     @classmethod
@@ -79,8 +78,9 @@ class Record:
         given = path_of(path, "vines.Record.load")
         found = given if os.path.exists(given) else _vines.find_record(given)
         record = cls.__new__(cls)
-        record._impl = _vines.Record.load(found, str(format), str(units), int(column), float(dt))
-        record._args = ("file", found, str(format), str(units), int(column), float(dt))
+        step = real(dt, "vines.Record.load: dt", finite=True)
+        record._impl = _vines.Record.load(found, str(format), str(units), int(column), step)
+        record._args = ("file", found, str(format), str(units), int(column), step)
         return record
 
     @property

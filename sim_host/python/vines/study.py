@@ -73,7 +73,7 @@ _TEXTS = ("status", "degraded_reasons", "error")
 
 def sweep(scene: Any, grid: Optional[Mapping[str, Any]] = None, set: Optional[Mapping[str, Any]] = None,
           cases: Optional[Sequence[Mapping[str, Any]]] = None, group_by: Optional[str] = None,
-          threads: int = 0, as_frame: bool = False) -> Any:
+          threads: int = 0, as_frame: bool = False, large: bool = False) -> Any:
     """Runs a study of `scene` as `vines sweep` runs one (data/studies/README.md).
 
     Parameters
@@ -92,10 +92,14 @@ def sweep(scene: Any, grid: Optional[Mapping[str, Any]] = None, set: Optional[Ma
         all the same: group them with numpy or pandas (the program's
         per-group statistics of summary.json are not computed here).
     threads : int
-        C++ threads (0: every core), with the GIL released; Ctrl-C stops
-        the runs and raises KeyboardInterrupt.
+        C++ threads (0: every core; at most 1024, as `vines sweep
+        --threads`), with the GIL released; Ctrl-C stops the runs and
+        raises KeyboardInterrupt.
     as_frame : bool
         A pandas DataFrame instead of a numpy record array.
+    large : bool
+        Runs a plan of more than 1,000,000 runs (`vines sweep --large`);
+        without it such a plan is refused before it takes any memory.
 
     Returns
     -------
@@ -112,16 +116,21 @@ def sweep(scene: Any, grid: Optional[Mapping[str, Any]] = None, set: Optional[Ma
         A key that is not a scene key, a bad range, a key set twice, a
         group_by that is not a grid key.
     ValueError
-        threads < 0.
+        threads outside 0-1024; a plan of more than 1,000,000 runs without
+        large=True, or one whose plan would take more than half the
+        machine's memory.
     """
     s = as_scene(scene, "vines.sweep: scene")
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
         raise TypeError("vines.sweep: threads: an int, not %s" % type(threads).__name__)
-    if threads < 0:
-        raise ValueError("vines.sweep: threads: %d; must be >= 0 (0: every core)" % threads)
+    if not 0 <= threads <= 1024:
+        raise ValueError("vines.sweep: threads: %d; must be 0 (every core) to 1024" % threads)
+    if not isinstance(large, (bool, np.bool_)):
+        raise TypeError("vines.sweep: large: a bool, not %s" % type(large).__name__)
     where = s.origin + " (sweep)"
     raw = _vines.sweep(s._impl, plain_dict(grid or {}, where + ": grid"), plain_dict(set or {}, where + ": set"),
-                       plain_list(cases or [], where + ": cases"), str(group_by or ""), int(threads))
+                       plain_list(cases or [], where + ": cases"), str(group_by or ""), int(threads),
+                       bool(large))
     columns: Dict[str, Any] = {key: np.asarray(values) for key, values in zip(raw["keys"], raw["values"])}
     for name in _NUMBERS:
         columns[name] = raw[name]
