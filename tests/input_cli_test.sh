@@ -119,6 +119,7 @@ if "$VINES" help view > /dev/null 2>&1; then
   expect 2 "--serve 80x: '80x' is not a port" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve 80x
   expect 2 "--serve 70000" -- "$VINES" view "$WORK" --serve 70000
   expect 2 "--serve :80: no host" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve :80
+  expect 2 "--serve ::1:0: an IPv6 address goes in brackets" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve ::1:0
   expect 2 "--serve-hold: it needs --serve" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve-hold 5
   expect 2 "--serve-hold" -- "$VINES" hil data/scenes/elcentro_vines.toml --serve 0 --serve-hold -1
   expect 1 "--serve 203.0.113.7:0: cannot listen there" -- "$VINES" hil data/scenes/elcentro_vines.toml \

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -208,7 +209,11 @@ TEST(Server, ParsesHostAndPortAndNamesABadOne) {
   const Address a = parse_address("--serve", "0.0.0.0:0");
   EXPECT_EQ(a.host, "0.0.0.0");
   EXPECT_EQ(a.port, 0);
-  for (const char* bad : {"", "abc", "70000", "-1", ":80", "localhost:", "8080x", "123456"}) {
+  const Address v6 = parse_address("--serve", "[::1]:0");
+  EXPECT_EQ(v6.host, "::1");
+  EXPECT_EQ(v6.port, 0);
+  for (const char* bad : {"", "abc", "70000", "-1", ":80", "localhost:", "8080x", "123456", "::1:0", "[::1]", "[]:80",
+                          "[::1]80", "[::1"}) {
     try {
       parse_address("--serve", bad);
       ADD_FAILURE() << bad;
@@ -257,6 +262,84 @@ TEST(Server, ServesThePageReadOnlyAndRefusesAPortInUse) {
   EXPECT_THROW(PageServer(hub, Address{"203.0.113.7", 0}), std::runtime_error);  // not this machine's
 }
 
+// A raw request's status line (its first line), or "" if none came.
+std::string raw_status(int port, const std::string& request) {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return "";
+  ::send(s, request.data(), request.size(), 0);
+  std::string got;
+  char buf[4096];
+  for (ssize_t n; (n = ::recv(s, buf, sizeof buf, 0)) > 0;) got.append(buf, static_cast<std::size_t>(n));
+  ::close(s);
+  return got.substr(0, got.find("\r\n"));
+}
+
+// DNS rebinding: a page of another site that resolves its name to this
+// machine sends its own Host; refused (421). The loopback names pass.
+TEST(Server, AnswersOnlyToTheHostNamesItIsBoundTo) {
+  Hub hub;
+  PageServer server(hub, Address{"127.0.0.1", 0});
+  const std::string port = std::to_string(server.port());
+  for (const std::string host : {"127.0.0.1:" + port, "localhost:" + port, "[::1]:" + port})
+    EXPECT_EQ(raw_status(server.port(), "GET / HTTP/1.1\r\nHost: " + host + "\r\n\r\n"), "HTTP/1.1 200 OK") << host;
+  for (const std::string host : {"evil.example:" + port, std::string("127.0.0.1:1"), std::string("localhost"), std::string()})
+    EXPECT_EQ(raw_status(server.port(), "GET / HTTP/1.1\r\nHost: " + host + "\r\n\r\n"),
+              "HTTP/1.1 421 Misdirected Request")
+        << host;
+  EXPECT_EQ(raw_status(server.port(), "GET /events HTTP/1.1\r\nHost: evil.example\r\n\r\n"),
+            "HTTP/1.1 421 Misdirected Request");
+  EXPECT_EQ(server.authority(), "127.0.0.1:" + port);
+}
+
+// One byte range is served (206); many in one request are refused (416):
+// 1,600 ranges "0-" of the index page built 2.9 MB from 1.8 KB.
+TEST(Server, ServesOneRangeAndRefusesMany) {
+  Hub hub;
+  PageServer server(hub, Address{"127.0.0.1", 0});
+  httplib::Client cli("127.0.0.1", server.port());
+  auto one = cli.Get("/", {{"Range", "bytes=0-9"}});
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->status, 206);
+  EXPECT_EQ(one->body.size(), 10u);
+  std::string many = "bytes=0-";
+  for (int i = 0; i < 1600; ++i) many += ",0-";
+  auto amp = cli.Get("/", {{"Range", many}});
+  ASSERT_TRUE(amp);
+  EXPECT_EQ(amp->status, 416);
+  EXPECT_EQ(amp->get_header_value("X-Refused"), "one byte range at most");
+  EXPECT_EQ(amp->body.size(), 0u);
+  EXPECT_EQ(raw_status(server.port(), "GET / HTTP/1.1\r\nHost: evil.example\r\nRange: " + many + "\r\n\r\n"),
+            "HTTP/1.1 416 Range Not Satisfiable");
+}
+
+// Bound to every interface, it says so; bound to the IPv6 loopback, its URL
+// has the address in brackets (skipped where the machine has no IPv6).
+TEST(Server, WarnsBeyondLoopbackAndTakesIPv6) {
+  Hub hub;
+  testing::internal::CaptureStderr();
+  { PageServer open(hub, Address{"0.0.0.0", 0}); }
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("open to every machine that can reach this one"), std::string::npos) << said;
+  testing::internal::CaptureStderr();
+  { PageServer local(hub, Address{"127.0.0.1", 0}); }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  std::unique_ptr<PageServer> v6;
+  try {
+    v6 = std::make_unique<PageServer>(hub, Address{"::1", 0});
+  } catch (const std::runtime_error& e) {
+    GTEST_SKIP() << "no IPv6 loopback here: " << e.what();
+  }
+  EXPECT_EQ(v6->url(), "http://[::1]:" + std::to_string(v6->port()) + "/");
+  httplib::Client cli("::1", v6->port());
+  auto r = cli.Get("/", {{"Host", "[::1]:" + std::to_string(v6->port())}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+}
+
 // A client that asks for /events and never reads: its socket fills, its
 // write times out and it is dropped, while the bench publishes 40 MB on
 // without waiting and a reading client gets every event.
@@ -273,7 +356,7 @@ TEST(Server, DropsAClientThatStopsReadingWithoutStallingTheBench) {
   addr.sin_port = htons(static_cast<std::uint16_t>(server.port()));
   addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(::connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  const std::string get = "GET /events HTTP/1.1\r\nHost: x\r\n\r\n";
+  const std::string get = "GET /events HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(server.port()) + "\r\n\r\n";
   ASSERT_EQ(::send(s, get.data(), get.size(), 0), static_cast<ssize_t>(get.size()));
   // The reading client.
   std::atomic<std::size_t> read_bytes{0};

@@ -58,6 +58,7 @@ class Hub {
   bool wait_until_read(std::chrono::milliseconds wait);
 
   int clients() const;
+  const HubLimits& limits() const { return limits_; }
   long long dropped() const;
   long long published() const;
 

@@ -1,6 +1,7 @@
 #include "sim_host/monitor/server.hpp"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <thread>
@@ -15,8 +16,15 @@ namespace vines::host::monitor {
 Address parse_address(const std::string& option, const std::string& value) {
   Address a;
   std::string port = value;
-  const std::size_t colon = value.rfind(':');
-  if (colon != std::string::npos) {
+  if (!value.empty() && value[0] == '[') {  // [IPv6]:PORT
+    const std::size_t close = value.find(']');
+    if (close == std::string::npos || close + 1 >= value.size() || value[close + 1] != ':' || close == 1)
+      throw std::invalid_argument(option + " " + value + ": expected [IPV6]:PORT, e.g. [::1]:8080");
+    a.host = value.substr(1, close - 1);
+    port = value.substr(close + 2);
+  } else if (value.find(':') != value.rfind(':')) {
+    throw std::invalid_argument(option + " " + value + ": an IPv6 address goes in brackets, [ADDRESS]:PORT, e.g. [::1]:8080");
+  } else if (const std::size_t colon = value.rfind(':'); colon != std::string::npos) {
     a.host = value.substr(0, colon);
     port = value.substr(colon + 1);
     if (a.host.empty()) throw std::invalid_argument(option + " " + value + ": no host before ':' (HOST:PORT or PORT)");
@@ -75,13 +83,29 @@ void serve_events(Hub& hub, httplib::Response& res) {
 
 PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Impl>(hub)), host_(at.host) {
   httplib::Server& srv = impl_->srv;
-  // Read-only: GET (and HEAD) only.
-  srv.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (req.method == "GET" || req.method == "HEAD") return httplib::Server::HandlerResponse::Unhandled;
-    res.status = 405;
-    res.set_header("Allow", "GET, HEAD");
-    res.set_content("this page is read-only\n", "text/plain");
-    return httplib::Server::HandlerResponse::Handled;
+  // Read-only: GET (and HEAD) only; to the Host names it is bound to (a page
+  // of another site, through DNS rebinding, cannot read it); one byte range
+  // at most (a request of many would build a response many times the file).
+  srv.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    auto refuse = [&res](int status, const std::string& why) {
+      res.status = status;
+      res.set_content(why + "\n", "text/plain");
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    // First, and with no body: cpp-httplib would cut any body into the
+    // request's ranges.
+    if (req.get_header_value("Range").find(',') != std::string::npos) {
+      res.status = 416;
+      res.set_header("X-Refused", "one byte range at most");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (!host_allowed(req.get_header_value("Host")))
+      return refuse(421, "this page answers to Host " + authority() + " only");
+    if (req.method != "GET" && req.method != "HEAD") {
+      res.set_header("Allow", "GET, HEAD");
+      return refuse(405, "this page is read-only");
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   for (const PageFile& f : page_files()) {
     srv.Get(std::string(f.path), [f](const httplib::Request&, httplib::Response& res) {
@@ -90,8 +114,15 @@ PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Imp
     });
   }
   srv.Get("/events", [&hub](const httplib::Request&, httplib::Response& res) { serve_events(hub, res); });
-  // A client that stops reading blocks its own thread for at most this long.
+  // A client that stops reading blocks its own thread for at most this long,
+  // one that sends nothing too; one request a connection; threads for the
+  // hub's clients (each holds one while it reads the events) and as many
+  // more, with eight to spare.
   srv.set_write_timeout(1, 0);
+  srv.set_read_timeout(5, 0);
+  srv.set_keep_alive_max_count(1);
+  const std::size_t threads = 2 * static_cast<std::size_t>(hub.limits().max_clients) + 8;
+  srv.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
   // SO_REUSEADDR only: httplib's default, SO_REUSEPORT, would let a second
   // program listen on a port in use (and share its clients).
   srv.set_socket_options([](socket_t sock) {
@@ -107,11 +138,35 @@ PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Imp
                              "; is the port in use, or the host not this machine's?)");
   }
   impl_->thread = std::thread([this] { impl_->srv.listen_after_bind(); });
+  if (!loopback())
+    std::fprintf(stderr,
+                 "--serve %s: the page is open to every machine that can reach this one on port %d (read-only, no "
+                 "password); --serve %d keeps it on this machine\n",
+                 authority().c_str(), port_, port_);
+}
+
+bool PageServer::loopback() const { return host_ == "127.0.0.1" || host_ == "localhost" || host_ == "::1"; }
+
+std::string PageServer::authority() const {
+  return (host_.find(':') != std::string::npos ? "[" + host_ + "]" : host_) + ":" + std::to_string(port_);
+}
+
+// The Host header a browser sends for this server's URL: the bound name and
+// port, or for a loopback server any of its names; any for one bound to
+// every interface (0.0.0.0, ::: its names are not known; it warned).
+bool PageServer::host_allowed(const std::string& host) const {
+  if (host_ == "0.0.0.0" || host_ == "::") return true;
+  const std::string port = ":" + std::to_string(port_);
+  if (host == authority()) return true;
+  if (!loopback()) return false;
+  for (const char* name : {"127.0.0.1", "localhost", "[::1]"})
+    if (host == name + port) return true;
+  return false;
 }
 
 PageServer::~PageServer() { stop(std::chrono::milliseconds(0)); }
 
-std::string PageServer::url() const { return "http://" + host_ + ":" + std::to_string(port_) + "/"; }
+std::string PageServer::url() const { return "http://" + authority() + "/"; }
 
 void PageServer::stop(std::chrono::milliseconds linger, bool hold) {
   if (!impl_->thread.joinable()) return;

@@ -11,18 +11,23 @@
 
 namespace vines::host::monitor {
 
-// Where to listen: --serve [HOST:]PORT (HOST 127.0.0.1 unless given).
+// Where to listen: --serve [HOST:]PORT or [IPV6]:PORT (HOST 127.0.0.1 unless
+// given).
 struct Address {
   std::string host = "127.0.0.1";
   int port = 0;  // 0: any free port
 };
-// Parses [HOST:]PORT; throws std::invalid_argument naming OPTION and VALUE.
+// Parses [HOST:]PORT or [IPV6]:PORT; throws std::invalid_argument naming
+// OPTION and VALUE (an IPv6 address without brackets too).
 Address parse_address(const std::string& option, const std::string& value);
 
 class PageServer {
  public:
   // Listens at once (the port known when this returns) and serves on its
   // own threads; throws std::runtime_error naming the address if it cannot.
+  // Bound beyond loopback, it says so on stderr. One request a connection,
+  // one byte range at most (416 otherwise), Host one of the names it is
+  // bound to (421 otherwise).
   PageServer(Hub& hub, const Address& at);
   ~PageServer();  // stop(0)
   PageServer(const PageServer&) = delete;
@@ -30,12 +35,15 @@ class PageServer {
 
   int port() const { return port_; }
   std::string url() const;
+  std::string authority() const;  // HOST:PORT, an IPv6 host in brackets
   // Gives the clients up to `linger` to read the hub's last events (close it
   // first), then stops. With `hold`, waits up to `linger` for a client to
   // have read the whole run (one may not have come yet), then stops.
   void stop(std::chrono::milliseconds linger, bool hold = false);
 
  private:
+  bool loopback() const;
+  bool host_allowed(const std::string& host) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string host_;
