@@ -277,7 +277,20 @@ TEST(Sweep, BadSpecsAreRefusedWithTheirKey) {
   refused("[[study]]\nname = \"a\"\n" + scene + "[[study]]\nname = \"a\"\n" + scene,
           "study 'a': a second study of that name");
   refused("[[study]]\n" + scene + "[study.grid]\n\"vines.beta\" = [1.2, 1.2000000000000002, 1.3]\n",
-          "vines.beta: values 1.2 and 1.2000000000000002 are closer than 1e-12");
+          "vines.beta: values 1.2 and 1.2000000000000002 differ by less than 1e-12 of their size");
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.beta\" = [1.2, 1.3, 1.2]\n",
+          "vines.beta: 1.2 is listed twice (one run)");
+  refused("[[study]]\n" + scene + "[study.grid]\n\"vines.law\" = [\"hertz\", \"tsuji\", \"hertz\"]\n",
+          "vines.law: 'hertz' is listed twice (one run)");
+  // Small values apart by more than 1e-12 of their size are two runs; ranges
+  // that share an end, one run at it.
+  for (const char* grid : {"\"loop.contact_rtol\" = [1e-14, 1e-13]\n",
+                           "\"vines.beta\" = [{ from = 1.2, to = 1.3, step = 0.1 }, { from = 1.3, to = 1.4, step = 0.1 }]\n"}) {
+    const fs::path g = dir / "small.toml";
+    std::ofstream(g) << "[[study]]\n" << scene << "[study.grid]\n" << grid;
+    const SweepSpec sp = load_sweep(g.string());
+    EXPECT_EQ(plan_runs(sp).size(), std::string(grid).find("rtol") != std::string::npos ? 2u : 3u) << grid;
+  }
   // A grid value the scene refuses fails that run with the scene's message.
   const fs::path f = dir / "bad_beta.toml";
   std::ofstream(f) << "[[study]]\n" << scene << "[study.grid]\n\"vines.beta\" = [0.9, 1.35]\n";

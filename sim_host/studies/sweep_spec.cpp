@@ -105,7 +105,7 @@ std::uint64_t axis_count(const toml::node& n) {
 
 Scaled grid_axis(const std::string& where, const std::string& key, const toml::node& n) {
   Scaled ax;
-  std::vector<double> numbers;
+  std::vector<double> numbers, listed;  // every value; those listed one by one
   bool all_integral = true;
   auto add_range = [&](const toml::table& t) {
     std::string scale;
@@ -123,22 +123,36 @@ Scaled grid_axis(const std::string& where, const std::string& key, const toml::n
         add_range(*tt);
       } else {
         KeyValue v = value_of(where, key, e);
-        if (!v.text.empty()) ax.values.push_back(v);
-        else { numbers.push_back(v.number); all_integral &= v.integral; }
+        if (!v.text.empty()) {
+          for (const KeyValue& w : ax.values)
+            if (w.text == v.text) fail(where, key + ": '" + v.text + "' is listed twice (one run): drop one");
+          ax.values.push_back(v);
+        } else {
+          numbers.push_back(v.number), listed.push_back(v.number);
+          all_integral &= v.integral;
+        }
       }
     }
   } else {
     fail(where, key + ": a grid key takes a list of values or a range table");
   }
-  // Union of the numbers, sorted, without duplicates: equal values (ranges
-  // that share an end) are one run; distinct values closer than 1e-12 would
-  // silently be one run too, and are refused.
+  // Union of the numbers, sorted, without duplicates: equal values of ranges
+  // that share an end are one run; a value listed twice is refused, as are
+  // distinct values within 1e-12 of each other relatively (their columns in
+  // results.csv would read the same).
+  std::sort(listed.begin(), listed.end());
+  for (std::size_t i = 1; i < listed.size(); ++i)
+    if (listed[i] == listed[i - 1]) {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, ": %.17g is listed twice (one run): drop one", listed[i]);
+      fail(where, key + msg);
+    }
   std::sort(numbers.begin(), numbers.end());
   numbers.erase(std::unique(numbers.begin(), numbers.end()), numbers.end());
   for (std::size_t i = 1; i < numbers.size(); ++i)
-    if (std::fabs(numbers[i] - numbers[i - 1]) <= 1e-12 * (1 + std::fabs(numbers[i - 1]))) {
+    if (std::fabs(numbers[i] - numbers[i - 1]) <= 1e-12 * std::max(std::fabs(numbers[i]), std::fabs(numbers[i - 1]))) {
       char msg[160];
-      std::snprintf(msg, sizeof msg, ": values %.17g and %.17g are closer than 1e-12 (one run): drop one",
+      std::snprintf(msg, sizeof msg, ": values %.17g and %.17g differ by less than 1e-12 of their size (one run): drop one",
                     numbers[i - 1], numbers[i]);
       fail(where, key + msg);
     }
