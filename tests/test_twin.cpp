@@ -264,6 +264,9 @@ TEST(Twin, BadInputsRefused) {
   o.sensors = {1, 2, 3, 4, 5, 6, 7, 8, 9};
   refused(o, "--sensors: at most 8 floors");
   o = twin(1.0);
+  o.floors = {3, 6, 3};  // two x_3_m columns in --csv
+  refused(o, "--floors 3: given twice");
+  o = twin(1.0);
   o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_truth_3_stories.toml";
   refused(o, "frame.stories 3 differs");
   o.truth_path = std::string(VINES_TEST_DATA_DIR) + "/twin_truth_kobe.toml";

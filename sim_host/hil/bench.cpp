@@ -57,12 +57,16 @@ void check_mode_options(const HilOptions& o) {
   }
 }
 
-// --floors: floors of the scene's frame.
+// --floors: floors of the scene's frame, each once (a column each).
 void check_floors(const HilOptions& o, const Scene& sc) {
   const int n = sc.params.frame.stories;
-  for (int f : o.floors)
+  for (std::size_t i = 0; i < o.floors.size(); ++i) {
+    const int f = o.floors[i];
     if (f < 1 || f > n)
       throw std::runtime_error("--floors " + std::to_string(f) + ": " + sc.path + " has floors 1 to " + std::to_string(n));
+    for (std::size_t j = 0; j < i; ++j)
+      if (o.floors[j] == f) throw std::runtime_error("--floors " + std::to_string(f) + ": given twice");
+  }
 }
 
 constexpr link::NodeMode kNodeModes[] = {link::NodeMode::kReplay, link::NodeMode::kTwin, link::NodeMode::kHybrid};
