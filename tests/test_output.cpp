@@ -282,6 +282,12 @@ TEST_F(OutputTest, EmptyPathAndFileInTheWayAreRefused) {
             path("file") + ": cannot create: a file of that name exists");
   const std::string below = message_of([&] { OutputDir(path("file/sub"), "vines run", {"summary.json"}); });
   EXPECT_EQ(below.rfind(path("file/sub") + ": cannot create: ", 0), 0u) << below;
+  // A symbolic link to nowhere: said so (it was "File exists"), for a run's
+  // folder and a sweep's alike.
+  fs::create_symlink("nowhere", dir_ / "gone");
+  const std::string said = path("gone") + ": cannot create: a symbolic link to nowhere, which does not exist";
+  EXPECT_EQ(message_of([&] { OutputDir(path("gone"), "vines run", {"summary.json"}); }).rfind(said, 0), 0u);
+  EXPECT_EQ(message_of([&] { vines::host::create_folder(path("gone")); }).rfind(said, 0), 0u);
 }
 
 // CsvWriter's numbers come from std::to_chars for "%.Nf", "%.Ng", "%.Ne": the

@@ -27,9 +27,7 @@ int reference(ReferenceArgs a) {
   const reference::ReferenceReport rep = reference::reference_report(scene, a.rtol);
   // The file's folder made if missing, then the file written atomically.
   const std::filesystem::path dir = std::filesystem::path(out).parent_path();
-  std::error_code ec;
-  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error(dir.string() + ": cannot create: " + ec.message());
+  if (!dir.empty()) create_folder(dir.string());
   write_file_atomic(out, rep.to_json().dump(2) + '\n');
   if (!a.quiet) {
     const reference::Result& r = rep.run;

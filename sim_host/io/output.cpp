@@ -150,14 +150,23 @@ std::string read_marker(int fd) {
 
 }  // namespace
 
+void create_folder(const std::string& dir) {
+  std::error_code ec;
+  const fs::path p(dir);
+  if (fs::is_symlink(p, ec) && !fs::exists(p, ec))
+    throw std::runtime_error(dir + ": cannot create: a symbolic link to " + fs::read_symlink(p, ec).string() +
+                             ", which does not exist (remove the link, or make its target)");
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec))
+    throw std::runtime_error(dir + ": cannot create: a file of that name exists");
+  fs::create_directories(p, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create: " + ec.message());
+}
+
 OutputDir::OutputDir(std::string dir, std::string command, std::vector<std::string> owned, std::string fingerprint)
     : dir_(std::move(dir)), command_(std::move(command)), owned_(std::move(owned)) {
   if (dir_.empty()) throw std::runtime_error(command_ + ": the output folder is an empty path");
+  create_folder(dir_);
   std::error_code ec;
-  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
-    throw std::runtime_error(dir_ + ": cannot create: a file of that name exists");
-  fs::create_directories(dir_, ec);
-  if (ec) throw std::runtime_error(dir_ + ": cannot create: " + ec.message());
   const std::string marker = file(kOutputMarker);
   struct stat ms {};
   const bool marked = ::lstat(marker.c_str(), &ms) == 0;

@@ -16,6 +16,8 @@
 //   is refused, naming the holder. finish() removes the command's own files
 //   this run did not write (a timeseries.csv of an earlier run beside a
 //   summary.json without one).
+// - create_folder: a folder and its parents made, or a refusal that says why
+//   (a file of that name, a symbolic link whose target does not exist).
 // - safe_file_name: a scene or spec name reduced to one safe path component.
 #pragma once
 
@@ -53,6 +55,9 @@ void write_file_atomic(const std::string& path, const std::string& text);
 // Keeps [A-Za-z0-9._-], every other byte becomes '_'; leading dots become '_'
 // (so never "." or ".." or hidden); "" becomes "_"; at most 100 bytes.
 std::string safe_file_name(const std::string& name);
+
+// Makes `dir` and its parents; throws "DIR: cannot create: <why>".
+void create_folder(const std::string& dir);
 
 // The marker's name in every output folder.
 inline constexpr const char* kOutputMarker = ".vines-output";

@@ -257,9 +257,7 @@ std::string write_case_scene(const StressCase& c, const std::vector<StressRecord
   const FrameParams& f = p.frame;
   const double dt = records[static_cast<std::size_t>(c.record)].record.dt_s;
   const std::string stem = "case_" + std::to_string(c.index);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error(dir + ": cannot create: " + ec.message());
+  create_folder(dir);
   // The window, scaled, one value a line in m/s^2 (17 digits: bit for bit).
   {
     std::string rec;

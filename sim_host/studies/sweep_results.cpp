@@ -161,9 +161,7 @@ json SweepSummary::to_json() const {
 SweepSummary write_sweep(const SweepSpec& spec, const std::vector<RunPlan>& plan,
                          const std::vector<RunResult>& results, const std::string& out_dir, double wall_s,
                          int cores) {
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec) throw std::runtime_error(out_dir + ": cannot create: " + ec.message());
+  create_folder(out_dir);
   write_results_csv(spec, plan, results, fs::path(out_dir) / "results.csv");
   SweepSummary s;
   s.spec = spec.path;
