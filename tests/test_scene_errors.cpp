@@ -78,6 +78,9 @@ TEST(SceneError, VinesValues) {
   // Bounded work whatever the parameters: a reference speed no impact has
   // is refused at once (1e-300 took 15 s to calibrate, tau 3e52 s).
   expect_refused(kBase + "[vines]\nv_ref_mps = 1e-300\n", {"bad.toml:7:", "vines.v_ref_mps", "[1e-4, 1000]"});
+  // tau_s without bound ran for hours (1e6 s: the sphere held on the wall).
+  expect_refused(kBase + "[vines]\ntau_s = 1e6\n", {"bad.toml:7:", "vines.tau_s", "(0, 1] s"});
+  expect_refused(kBase + "[vines]\ntau_s = -1e-3\n", {"bad.toml:7:", "vines.tau_s", "(0, 1] s"});
   // A derived value out of range names the inputs it comes from (beta
   // 1e308: the free travel overflowed to null fields, status ok).
   expect_refused(kBase + "[vines]\nbeta = 1e308\n",

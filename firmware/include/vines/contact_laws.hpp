@@ -94,7 +94,9 @@ struct Kuwabara {
     const ParamError e = check_eps(v);
     if (!e.ok()) return e;
     if (v.tau_s != 0.0) {
-      if (!std::isfinite(v.tau_s) || v.tau_s < 0.0) return {"vines.tau_s", "must be >= 0"};
+      // A steel sphere's is under a millisecond; a long one holds the sphere
+      // on the wall, each step at its most substeps (1e6 s: a run of hours).
+      if (!(std::isfinite(v.tau_s) && v.tau_s > 0.0 && v.tau_s <= 1.0)) return {"vines.tau_s", "must be in (0, 1] s"};
     } else if (!(std::isfinite(v.v_ref_mps) && v.v_ref_mps >= 1e-4 && v.v_ref_mps <= 1e3)) {
       // Below 0.1 mm/s no impact is measured, and the calibration's contact
       // time grows without bound (1e-300 m/s: 15 s of work, tau 3e52 s).
