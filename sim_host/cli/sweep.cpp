@@ -1,5 +1,4 @@
 // `vines sweep SPEC.toml`: the grid of runs of a study spec, on threads and MPI ranks.
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -51,12 +50,8 @@ bool check_plan_size(const host::SweepSpec& spec, std::uint64_t n, const SweepAr
                      const std::atomic<bool>* stop) {
   using namespace vines::host;
   if (n <= kLargePlan) return true;
-  std::size_t values = 0;
-  for (const StudySpec& st : spec.studies)
-    values = std::max(values, (st.cases.empty() ? 0 : st.cases.front().size()) + st.grid_axes.size());
-  const double per_run = sizeof(RunPlan) + sizeof(RunResult) + values * (sizeof(KeyValue) + 32.0);
-  const double memory = static_cast<double>(n) * per_run;
-  const double ram = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  const double memory = plan_memory_bytes(spec, n);
+  const double ram = machine_memory_bytes();
   char size[160];
   std::snprintf(size, sizeof size, "%s: the plan has %llu runs (more than %llu) and needs about %.1f GB of memory",
                 a.spec_path.c_str(), static_cast<unsigned long long>(n), static_cast<unsigned long long>(kLargePlan),

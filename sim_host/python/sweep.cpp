@@ -11,8 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "sim_host/python/module.hpp"
 #include "sim_host/studies/sweep.hpp"
 
@@ -54,12 +52,11 @@ py::dict sweep(const PyScene& s, const py::dict& grid, const py::dict& set, cons
     // take more than half the machine's memory is refused whatever.
     const std::uint64_t n = plan_size(spec);
     if (n > kLargePlan) {
-      const double gb = static_cast<double>(n) * (sizeof(RunPlan) + sizeof(RunResult)) / 1e9;
-      const double ram = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+      const double memory = plan_memory_bytes(spec, n);
       std::ostringstream why;
       why << origin << ": the plan has " << n << " runs (more than " << kLargePlan << ") and needs about "
-          << static_cast<double>(static_cast<long long>(gb * 10)) / 10 << " GB of memory";
-      if (gb * 1e9 > ram / 2) throw std::invalid_argument(why.str() + ", more than half of this machine's: split the grid");
+          << static_cast<double>(static_cast<long long>(memory / 1e8)) / 10 << " GB of memory";
+      if (memory > machine_memory_bytes() / 2) throw std::invalid_argument(why.str() + ", more than half of this machine's: split the grid");
       if (!large) throw std::invalid_argument(why.str() + ": pass large=True to run it");
     }
     plan = plan_runs(spec);

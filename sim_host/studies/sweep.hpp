@@ -112,6 +112,11 @@ SweepSpec parse_sweep(const std::string& text, const std::string& path);
 // The number of runs of the spec, from its axes (nothing materialised);
 // UINT64_MAX when the product overflows.
 std::uint64_t plan_size(const SweepSpec& spec);
+// About the memory a plan of n runs of the spec takes with its results
+// [bytes], and this machine's memory [bytes]: a plan over half of it is
+// refused (vines sweep, vines.sweep).
+double plan_memory_bytes(const SweepSpec& spec, std::uint64_t n);
+double machine_memory_bytes();
 
 // Run `index` (< plan_size) of the spec.
 RunPlan plan_run(const SweepSpec& spec, std::uint64_t index);

@@ -2,6 +2,7 @@
 // runs they make (format at the top of sweep.hpp).
 #include <fnmatch.h>
 #include <toml++/toml.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -358,6 +359,18 @@ std::uint64_t study_size(const StudySpec& st) {
 }
 
 }  // namespace
+
+double plan_memory_bytes(const SweepSpec& spec, std::uint64_t n) {
+  std::size_t values = 0;
+  for (const StudySpec& st : spec.studies)
+    values = std::max(values, (st.cases.empty() ? 0 : st.cases.front().size()) + st.grid_axes.size());
+  const double per_run = sizeof(RunPlan) + sizeof(RunResult) + values * (sizeof(KeyValue) + 32.0);
+  return static_cast<double>(n) * per_run;
+}
+
+double machine_memory_bytes() {
+  return static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+}
 
 std::uint64_t plan_size(const SweepSpec& spec) {
   constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
