@@ -359,12 +359,12 @@ TEST(Server, DropsAClientThatStopsReadingWithoutStallingTheBench) {
   const std::string get = "GET /events HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(server.port()) + "\r\n\r\n";
   ASSERT_EQ(::send(s, get.data(), get.size(), 0), static_cast<ssize_t>(get.size()));
   // The reading client.
-  std::atomic<std::size_t> read_bytes{0};
+  std::string body;
   std::thread reader([&] {
     httplib::Client cli("127.0.0.1", server.port());
     cli.set_read_timeout(30, 0);
-    cli.Get("/events", [&](const char*, std::size_t n) {
-      read_bytes += n;
+    cli.Get("/events", [&](const char* p, std::size_t n) {
+      body.append(p, n);
       return true;
     });
   });
@@ -384,11 +384,80 @@ TEST(Server, DropsAClientThatStopsReadingWithoutStallingTheBench) {
   hub.close();
   reader.join();
   ::close(s);
-  const std::size_t header = std::string("event: meta\ndata: {}\n\n").size();
-  EXPECT_EQ(read_bytes.load(), header + 4000 * event.size());
+  // Its events whole, less the comments an idle stream sends (":", a blank line).
+  std::string events;
+  for (std::size_t at = 0; at < body.size();) {
+    const std::size_t end = std::min(body.find('\n', at), body.size() - 1) + 1;
+    if (body[at] != ':') events.append(body, at, end - at);
+    at = end + (body[at] == ':' && end < body.size() && body[end] == '\n');  // a comment and its blank line
+  }
+  const std::string header = "event: meta\ndata: {}\n\n";
+  ASSERT_EQ(events.size(), header.size() + 4000 * event.size());
+  EXPECT_EQ(events.substr(0, header.size()), header);
   EXPECT_LT(worst_publish_s, 0.05) << "a publish waited";
   EXPECT_LT(publish_s, 10.0);
   server.stop(1000ms);
+}
+
+// A socket to the server, connected; -1 if not.
+int connect_to(int port) {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(s);
+    return -1;
+  }
+  return s;
+}
+
+// Slow clients (issue 53): one that sends a header byte every 0.4 s is cut
+// 5 s after it came; sixteen that send nothing do not keep the page from
+// another client; a 64 KB header is refused; and the stop closes a half-sent
+// request at once rather than waiting for it.
+TEST(Server, NoClientStallsThePageOrItsStop) {
+  Hub hub;
+  auto server = std::make_unique<PageServer>(hub, Address{"127.0.0.1", 0});
+  const int port = server->port();
+  const std::string start = "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\nX-Slow: ";
+  std::atomic<double> cut_after_s{-1};
+  std::thread slow([&] {
+    const int s = connect_to(port);
+    ASSERT_GE(s, 0);
+    ::send(s, start.data(), start.size(), MSG_NOSIGNAL);
+    const auto t0 = Clock::now();
+    for (int i = 0; i < 50; ++i) {
+      std::this_thread::sleep_for(400ms);
+      if (::send(s, "a", 1, MSG_NOSIGNAL) != 1) break;
+      char c;
+      if (::recv(s, &c, 1, MSG_DONTWAIT) == 0) break;  // closed by the server
+    }
+    cut_after_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    ::close(s);
+  });
+  std::vector<int> idle;
+  for (int i = 0; i < 16; ++i) idle.push_back(connect_to(port));
+  const auto t1 = Clock::now();
+  EXPECT_EQ(raw_status(port, "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n\r\n"),
+            "HTTP/1.1 200 OK");
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t1).count(), 1.0);
+  const std::string big = "GET / HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\nX-Big: " +
+                          std::string(64 * 1024, 'b') + "\r\n\r\n";
+  EXPECT_NE(raw_status(port, big), "HTTP/1.1 200 OK");
+  slow.join();
+  EXPECT_GT(cut_after_s.load(), 4.0);
+  EXPECT_LT(cut_after_s.load(), 8.0);
+  for (int s : idle) ::close(s);
+  // A request half sent when the page stops: the stop does not wait for it.
+  const int half = connect_to(port);
+  ::send(half, start.data(), start.size(), MSG_NOSIGNAL);
+  std::this_thread::sleep_for(100ms);
+  const auto t2 = Clock::now();
+  server->stop(0ms);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t2).count(), 1.0);
+  ::close(half);
 }
 
 // `vines view`: a run's CSV back into the page's frames, the same series and

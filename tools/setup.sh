@@ -19,13 +19,14 @@ build=(
   libeigen3-dev libtomlplusplus-dev nlohmann-json3-dev
   libcli11-dev                                   # the vines command line
   libtbb-dev                                     # the parallel map of sweep, design, stress
-  libcpp-httplib-dev pkg-config                  # the monitoring page (vines hil --serve, view)
+  libmicrohttpd-dev pkg-config                   # the monitoring page (vines hil --serve, view)
 )
 plots=(
   python3-matplotlib python3-numpy               # plots: use /usr/bin/python3
 )
 rest=(
   libgtest-dev libgmock-dev libbenchmark-dev     # tests, benchmarks
+  libcpp-httplib-dev                             # the page's tests' HTTP client
   libsundials-dev                                # CVODE baseline (vines bench, tests)
   pybind11-dev python3-dev python3-pytest        # the Python package and its tests,
   mypy python3-pandas                            # its typing (mypy --strict), DataFrames

@@ -51,8 +51,8 @@ void ServedPage::stop(std::chrono::milliseconds linger, bool hold) {
 #else
 struct ServedPage::Impl {};
 ServedPage::ServedPage() {
-  throw std::runtime_error("--serve: this vines was built without the monitoring page (cpp-httplib not found: "
-                           "install libcpp-httplib-dev and reconfigure)");
+  throw std::runtime_error("--serve: this vines was built without the monitoring page (libmicrohttpd not found: "
+                           "install libmicrohttpd-dev and reconfigure)");
 }
 ServedPage::~ServedPage() = default;
 void ServedPage::listen(const std::string&, const std::string&) {}

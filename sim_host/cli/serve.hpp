@@ -1,6 +1,6 @@
 // The monitoring page on the command line (sim_host/monitor/): --serve of
 // `vines hil` and `vines view`, and the page served while a command runs.
-// Without cpp-httplib in the build, the page is refused with the reason.
+// Without libmicrohttpd in the build, the page is refused with the reason.
 #pragma once
 
 #include <chrono>

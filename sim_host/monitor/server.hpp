@@ -1,6 +1,8 @@
-// The page's HTTP server, on cpp-httplib (its own threads): GET of the page's
-// files and of /events, the hub's events as Server-Sent Events; any other
-// method refused (405): nothing on the page can change the run.
+// The page's HTTP server, on libmicrohttpd (its own threads, one a
+// connection): GET of the page's files and of /events, the hub's events as
+// Server-Sent Events; any other method refused (405): nothing on the page can
+// change the run. Every request is bounded: its headers in time and bytes, its
+// silence, the connections at once; stopping closes every connection.
 #pragma once
 
 #include <chrono>
@@ -8,6 +10,8 @@
 #include <string>
 
 #include "sim_host/monitor/hub.hpp"
+
+struct MHD_Connection;
 
 namespace vines::host::monitor {
 
@@ -26,8 +30,9 @@ class PageServer {
   // Listens at once (the port known when this returns) and serves on its
   // own threads; throws std::runtime_error naming the address if it cannot.
   // Bound beyond loopback, it says so on stderr. One request a connection,
-  // one byte range at most (416 otherwise), Host one of the names it is
-  // bound to (421 otherwise).
+  // its request line and headers within 5 s and 16 KB, one byte range at
+  // most (416 otherwise), Host one of the names it is bound to (421
+  // otherwise).
   PageServer(Hub& hub, const Address& at);
   ~PageServer();  // stop(0)
   PageServer(const PageServer&) = delete;
@@ -42,6 +47,7 @@ class PageServer {
   void stop(std::chrono::milliseconds linger, bool hold = false);
 
  private:
+  int answer(MHD_Connection* c, const char* url, const char* method);  // an MHD_Result
   bool loopback() const;
   bool host_allowed(const std::string& host) const;
   struct Impl;
