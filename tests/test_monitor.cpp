@@ -9,6 +9,7 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -512,9 +513,100 @@ TEST(View, ReadsARunsCsvIntoTheSameFrames) {
     load_run(csv.string(), &other);
     ADD_FAILURE();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("row 52, column ag_sent_mps2: 'oops'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 52, column ag_sent_mps2: 'oops'"), std::string::npos) << e.what();
   }
   EXPECT_THROW(load_run((dir / "none.csv").string(), &other), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}
+
+// The message load_run refuses FILE with ("" if it takes it).
+std::string view_refusal(const std::filesystem::path& file) {
+  Hub hub;
+  try {
+    load_run(file.string(), &hub);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// `vines view` reads what the run wrote beside its CSV (FILE.json: the rate,
+// the device, its floor and walls, the stories), takes CRLF lines, and
+// refuses a file it cannot trust, naming the line and the column (issue 53).
+TEST(View, ReadsTheRunsDescriptionAndRefusesWhatItCannotTrust) {
+  const auto dir = std::filesystem::temp_directory_path() / "vines_test_view_trust";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string head =
+      "k,t_s,ag_sent_mps2,ag_used_mps2,received,flags,latency_us,x_top_m,x_top_offline_m,deviation_m,"
+      "acc_top_mps2,Ee_Js,particle_x_m,contact_force_n,dissipated_J,aux,drift_alarms";
+  // A VI NES replay at 2048 Hz with no impact yet, as `vines hil --csv` writes it (t_s to the microsecond).
+  const auto write = [&](const std::string& name, const std::string& header, int rows, const std::string& eol,
+                         const std::string& bad_row = "") {
+    std::ofstream f(dir / name, std::ios::binary);
+    f << header << eol;
+    for (int k = 0; k < rows; ++k) {
+      char t[32];
+      std::snprintf(t, sizeof t, "%.6f", k / 2048.0);
+      f << k << "," << t << ",0.1,0,1,0,0,0.01,0,0,0,0,0.001,0,0,0,0" << eol;
+    }
+    f << bad_row;
+    return dir / name;
+  };
+  const auto csv = write("run.csv", head, 40, "\r\n");
+  {
+    std::ofstream m(dir / "run.csv.json");
+    m << R"({"format": "vines hil --csv", "columns": 17, "mode": "replay", "scene": "s.toml",
+            "sensor_rate_hz": 2048, "stories": 10, "device": {"kind": "vines", "floor": 10, "gap_m": 0.0135},
+            "floors": []})";
+  }
+  Hub hub;
+  load_run(csv.string(), &hub);
+  const std::optional<long long> c = hub.join();
+  Hub::Next last{};
+  const auto [name, meta] = parse_event(read_all(hub, *c, &last).at(0));
+  EXPECT_EQ(meta["rate_hz"], 2048.0);
+  EXPECT_EQ(meta["stories"], 10);
+  EXPECT_EQ(meta["device"]["kind"], "vines");  // no contact yet: drawn as a TMD before
+  EXPECT_EQ(meta["device"]["floor_series"], "x_top_m");
+  EXPECT_EQ(meta["device"]["gap_m"], 0.0135);
+  // Without the description: the rate from the times' whole span (1/(t1 - t0) gave 2049.18 Hz).
+  const auto bare = write("bare.csv", head, 40, "\n");
+  Hub h2;
+  load_run(bare.string(), &h2);
+  const auto [n2, m2] = parse_event(read_all(h2, *h2.join(), &last).at(0));
+  EXPECT_NEAR(m2["rate_hz"].get<double>(), 2048.0, 0.01);
+  // A description of another file.
+  { std::ofstream(dir / "bare.csv.json") << R"({"format": "vines hil --csv", "columns": 18})"; }
+  EXPECT_NE(view_refusal(bare).find("bare.csv.json: describes a CSV of 18 columns"), std::string::npos)
+      << view_refusal(bare);
+  std::filesystem::remove(dir / "bare.csv.json");
+  // Cells it cannot trust: each named by its line and column.
+  const std::string row = "0.1,0,1,0,0,0.01,0,0,0,0,0,0,0,0,0\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"40,nan," + row, "line 42, column t_s: 'nan'"},
+      {"40,0.001," + row, "line 42, column t_s: '0.001' is not a time after"},
+      {"39,0.5," + row, "line 42, column k: '39'"},
+      {"nan,0.5," + row, "line 42, column k: 'nan'"},
+      {"1e300,0.5," + row, "line 42, column k: '1e300'"},
+      {"-5,0.5," + row, "line 42, column k: '-5'"},
+      {"40.5,0.5," + row, "line 42, column k: '40.5'"},
+      {"40,0.5,0.1,0,nan,0,0,0.01,0,0,0,0,0,0,0,0,0\n", "line 42, column received: 'nan' is neither 0 nor 1"},
+  };
+  for (const auto& [r, want] : bad) {
+    const auto f = write("bad.csv", head, 40, "\n", r);
+    EXPECT_NE(view_refusal(f).find(want), std::string::npos) << r << " -> " << view_refusal(f);
+  }
+  EXPECT_NE(view_refusal(write("dup.csv", head + ",x_top_m", 3, "\n")).find("line 1: column 18 is 'x_top_m' again (column 8)"),
+            std::string::npos);
+  std::string wide = head;
+  for (int i = 0; i < 5000; ++i) wide += ",x_" + std::to_string(i);
+  EXPECT_NE(view_refusal(write("wide.csv", wide, 0, "\n")).find("line 1 has 5017 columns (at most 4096)"),
+            std::string::npos);
+  const auto fifo = dir / "fifo.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(view_refusal(fifo).find("not a regular file"), std::string::npos) << view_refusal(fifo);
+  EXPECT_NE(view_refusal("/dev/zero").find("/dev/zero: not a regular file"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
 

@@ -153,7 +153,7 @@ void add_hil(CLI::App& vines) {
       ->type_name("S")
       ->check(number_in(1e-3, 1e6));
   add_accept_degraded(*cmd, &a->accept_degraded);
-  cmd->add_option("--csv", opt.csv, "one row per step")->type_name("FILE")->check(non_empty_path());
+  cmd->add_option("--csv", opt.csv, "one row per step (and FILE.json beside it: the run, for vines view)")->type_name("FILE")->check(non_empty_path());
   add_number_list(*cmd, "--floors", &opt.floors, 1, 1000,
                   "floors whose displacement --csv (x_F_m) and the page (--serve) add, 1-based, comma-separated "
                   "(the top floor's is always there)")

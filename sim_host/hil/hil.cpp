@@ -5,6 +5,7 @@
 
 #include <memory>
 
+#include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/bench.hpp"
 #include "sim_host/hil/faults.hpp"
 #include "sim_host/hil/link/stream.hpp"
@@ -44,9 +45,20 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch) {
   // Its score, the mode's results and the CSV.
   HilReport report = score(b, rec, offline, restarts.empty() ? offline : lives, &events);
   mode->report(rec, offline, &report);
-  if (!b.opt.csv.empty())
-    write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec),
-                  b.opt.floors);
+  if (!b.opt.csv.empty()) {
+    CsvMeta meta;
+    meta.columns = write_hil_csv(b.opt.csv, rec, offline, b.scene.params.frame.stories, b.h, mode->csv_columns(rec),
+                                 b.opt.floors);
+    meta.mode = hil_mode_name(b.opt.mode), meta.scene = b.scene.path, meta.rate_hz = 1 / b.h;
+    meta.stories = b.scene.params.frame.stories, meta.floors = b.opt.floors;
+    const DeviceKind dev = b.scene.params.device.kind;
+    if (dev != DeviceKind::kNone) {
+      const ModelInfo info = build_engine(b.scene.params, b.scene.scalar, b.scene.path)->info();
+      meta.device = dev == DeviceKind::kTmd ? "tmd" : "vines", meta.device_floor = info.device_floor;
+      if (dev == DeviceKind::kVines) meta.gap_m = info.vines.gap;
+    }
+    write_hil_csv_meta(b.opt.csv, meta);
+  }
   if (watch) watch->finish(report);
   return report;
 }

@@ -4,6 +4,7 @@
 
 #include "sim_host/hil/record.hpp"
 #include "sim_host/io/csv.hpp"
+#include "sim_host/io/output.hpp"
 
 namespace vines::host {
 namespace {
@@ -172,9 +173,10 @@ json to_json(const HilReport& r) {
   return j;
 }
 
-void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h, const CsvColumns& extra, const std::vector<int>& floors) {
+int write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
+                  int stories, double h, const CsvColumns& extra, const std::vector<int>& floors) {
   CsvWriter f(path);
+  int columns = 17;
   const bool hybrid = !rec.table_x.empty();
   const int n = stories;
   // Header, then one row per sample (a sample without telemetry: zeros).
@@ -186,6 +188,7 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
   for (const std::string& c : extra.names) f.raw(c);
   for (int fl : floors) f.raw("x_" + std::to_string(fl) + "_m");
   f.end_row();
+  columns += (hybrid ? 2 : 0) + static_cast<int>(extra.names.size() + floors.size());
   constexpr const char* kFull = "%.17g";
   for (long long k = 0; k < rec.samples; ++k) {
     const link::Telemetry& t = rec.tel[k];
@@ -203,6 +206,18 @@ void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vec
     f.end_row();
   }
   f.close();
+  return columns;
+}
+
+nlohmann::json to_json(const CsvMeta& m) {
+  return {{"format", "vines hil --csv"}, {"columns", m.columns},     {"mode", m.mode},
+          {"scene", m.scene},            {"sensor_rate_hz", m.rate_hz}, {"stories", m.stories},
+          {"device", {{"kind", m.device}, {"floor", m.device_floor}, {"gap_m", m.gap_m}}},
+          {"floors", m.floors}};
+}
+
+void write_hil_csv_meta(const std::string& csv_path, const CsvMeta& m) {
+  write_file_atomic(csv_path + ".json", to_json(m).dump(2) + "\n");
 }
 
 }  // namespace vines::host

@@ -178,9 +178,22 @@ struct HilReport {
 nlohmann::json to_json(const HilReport& r);
 
 // Writes --csv: one row per sample (hybrid: with the table and the load cell;
-// then the mode's columns, then x_F_m of each of `floors`, 1-based). Throws
-// naming the file if it cannot be written.
-void write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
-                   int stories, double h, const CsvColumns& extra = {}, const std::vector<int>& floors = {});
+// then the mode's columns, then x_F_m of each of `floors`, 1-based); returns
+// its column count. Throws naming the file if it cannot be written.
+int write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
+                  int stories, double h, const CsvColumns& extra = {}, const std::vector<int>& floors = {});
+
+// What a --csv cannot say of its run, written beside it as PATH.json for
+// `vines view`: the format and its column count, the mode, the scene, the
+// sensor rate, the stories, the device (kind, floor, the VI NES box's free
+// travel) and the floors of its x_F_m columns.
+struct CsvMeta {
+  std::string mode, scene, device = "none";
+  double rate_hz = 0, gap_m = 0;
+  int stories = 0, device_floor = 0, columns = 0;
+  std::vector<int> floors;
+};
+nlohmann::json to_json(const CsvMeta& m);
+void write_hil_csv_meta(const std::string& csv_path, const CsvMeta& m);
 
 }  // namespace vines::host
