@@ -42,6 +42,7 @@ void print_twin(const host::HilTwinReport& t) {
   } else {
     std::printf("    no damage detected\n");
   }
+  if (!t.caveat.empty()) std::printf("    CAVEAT: %s\n", t.caveat.c_str());
   std::printf("    eta_k (sd) by story:");
   for (std::size_t i = 0; i < t.eta_k.size(); ++i) std::printf(" %.3f (%.3f)", t.eta_k[i], t.eta_k_sd[i]);
   std::printf("\n    roof displacement NRMSE %s (steady-state sd %.3g mm)\n",

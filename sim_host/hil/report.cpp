@@ -58,6 +58,7 @@ json to_json(const HilTwinReport& t) {
               {"sizes", t.sizes},
               {"size", to_json(t.size)},
               {"onset_s", to_json(t.onset_s)},
+              {"caveat", t.caveat.empty() ? json(nullptr) : json(t.caveat)},
               {"detect_time_s", to_json(t.detect_time_s)},
               {"detect_delay_s", to_json(t.detect_delay_s)},
               {"eta_k", t.eta_k},

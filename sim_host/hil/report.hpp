@@ -94,6 +94,7 @@ struct HilTwinReport {
   // from strong_motion_start_s.
   std::optional<double> size, detect_time_s, detect_delay_s;
   std::optional<double> onset_s;           // when the node estimates the change happened
+  std::string caveat;                      // why the verdict may be wrong ("": none seen)
   double strong_motion_start_s = 0;
   std::vector<double> eta_k, eta_k_sd;     // at the end, per story
   std::optional<double> roof_displacement_nrmse;  // RMS error over the truth's RMS

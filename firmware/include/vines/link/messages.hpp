@@ -60,6 +60,7 @@ enum StepFlag : std::uint16_t {
   kGuard = 1u << 7,         // the core's guards acted (sample held or step rolled back)
   kDamage = 1u << 8,        // twin estimator: damage detected (latched), story in alarm_story
   kDeviceAlarm = 1u << 9,   // twin estimator: the TMD's spring off its design (detuned)
+  kImpact = 1u << 10,       // twin estimator: a VI NES impact (its impact gain on): no residual alarm
 };
 
 struct Telemetry {

@@ -24,10 +24,12 @@ class ModeOutputs {
   }
 
   // Twin: the residual of the measured top-floor acceleration (have: it was
-  // measured), its running RMS, and the drift alarms.
+  // measured), its running RMS (a VI NES impact's samples left out: the
+  // estimator has no model of the impact, and its residual there is not the
+  // model's error), and the drift alarms.
   void twin(const NodeConfig& cfg, double h, Telemetry* t, double measured, bool have) {
     t->aux = have ? measured - t->acc_top : 0.0;
-    if (have) ms_residual_ += (t->aux * t->aux - ms_residual_) * std::fmin(1.0, h / cfg.residual_window_s);
+    if (have && !(t->flags & kImpact)) ms_residual_ += (t->aux * t->aux - ms_residual_) * std::fmin(1.0, h / cfg.residual_window_s);
     if (cfg.residual_limit_mps2 > 0 && std::sqrt(ms_residual_) > cfg.residual_limit_mps2) t->flags |= kResidualAlarm;
     for (int i = 0; i < t->n; ++i) {
       const double drift = t->x[i] - (i ? t->x[i - 1] : 0.0);

@@ -78,6 +78,7 @@ class TwinPlant {
     t->onset_s = est_.onset_step() < 0 ? -1.0 : static_cast<double>(est_.onset_step()) * est_.period();
     if (est_.detected()) t->flags |= kDamage;
     if (est_.device_alarm()) t->flags |= kDeviceAlarm;
+    if (est_.impact()) t->flags |= kImpact;
   }
 
  private:

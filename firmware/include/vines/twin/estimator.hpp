@@ -97,6 +97,9 @@ class Estimator : public ImageDecoder<S, N> {
   bool detected() const { return dec_.detected(); }
   S change_score() const { return score_; }  // the score statistic (section 5)
   bool device_alarm() const { return device_alarm_; }
+  // An impact (VI NES): the innovations jumped, the impact gain is on; the
+  // frame's model does not explain these samples.
+  bool impact() const { return impact_left_ > 0 && d_.extra == TwinExtra::kForce; }
 
  private:
   using Base::d_, Base::set_, Base::kind_, Base::dA_, Base::B0_, Base::B1_, Base::G_, Base::W_;
