@@ -30,6 +30,31 @@ set(CMAKE_C_COMPILER arm-none-eabi-gcc)
 set(CMAKE_CXX_COMPILER arm-none-eabi-g++)
 set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
 
+# The toolchain whole, checked at every configure: a compiler without its C
+# and C++ libraries passes CMake's checks (they build no executable) and the
+# images' link then fails on the heap ban's symbols (__wrap_malloc), which
+# says nothing of what is missing.
+if(NOT CMAKE_IN_TRY_COMPILE)
+  set(_fresh "install it (bash tools/setup.sh all), then configure again: cmake --preset ${VINES_BOARD} --fresh")
+  find_program(VINES_ARM_GCC arm-none-eabi-gcc NO_CACHE)
+  if(NOT VINES_ARM_GCC)
+    message(FATAL_ERROR "${VINES_BOARD}: the Arm toolchain (arm-none-eabi-gcc, Debian gcc-arm-none-eabi) "
+      "is not installed; ${_fresh}")
+  endif()
+  foreach(_lib libc_nano.a:libnewlib-arm-none-eabi libstdc++_nano.a:libstdc++-arm-none-eabi-newlib)
+    string(REPLACE ":" ";" _pair ${_lib})
+    list(GET _pair 0 _file)
+    list(GET _pair 1 _package)
+    separate_arguments(_cpu UNIX_COMMAND "${VINES_MCU_CPU_FLAGS}")
+    execute_process(COMMAND ${VINES_ARM_GCC} ${_cpu} --specs=nano.specs -print-file-name=${_file}
+      OUTPUT_VARIABLE _path OUTPUT_STRIP_TRAILING_WHITESPACE)
+    if(NOT IS_ABSOLUTE "${_path}" OR NOT EXISTS "${_path}")
+      message(FATAL_ERROR "${VINES_BOARD}: arm-none-eabi-gcc finds no ${_file} (Debian ${_package} is "
+        "not installed); ${_fresh}")
+    endif()
+  endforeach()
+endif()
+
 # Compiler checks cannot link a bare-metal executable (no startup, no script).
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
