@@ -2,6 +2,7 @@
 // records, runs and modal report for Python. The package around it
 // (vines/__init__.py) gives the results their Python shape (attributes,
 // numpy arrays); every check and message is the command line's own.
+#include <algorithm>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -333,10 +334,17 @@ PYBIND11_MODULE(_vines, m) {
       .def("run", [](PyLoop& l, const py::array_t<double, py::array::c_style | py::array::forcecast>& a) {
         l.require_started();
         if (a.ndim() != 1) throw std::invalid_argument("vines.Loop.run: the samples must be one-dimensional");
-        {
-          const Busy busy(l);
-          py::gil_scoped_release release;
-          l.eng->run(a.data(), static_cast<std::size_t>(a.shape(0)));
+        // In chunks, Ctrl-C heard between them (KeyboardInterrupt: the loop
+        // then at the end of the last chunk run, its state whole).
+        constexpr std::size_t kChunk = std::size_t{1} << 16;
+        const std::size_t n = static_cast<std::size_t>(a.shape(0));
+        const Busy busy(l);
+        for (std::size_t at = 0; at < n; at += kChunk) {
+          {
+            py::gil_scoped_release release;
+            l.eng->run(a.data() + at, std::min(kChunk, n - at));
+          }
+          if (PyErr_CheckSignals() != 0) throw py::error_already_set();
         }
         return step_dict(l.eng->snapshot(), l.stories);
       }, py::arg("samples"))
