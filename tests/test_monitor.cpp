@@ -315,6 +315,16 @@ TEST(Server, ServesOneRangeAndRefusesMany) {
   EXPECT_EQ(amp->body.size(), 0u);
   EXPECT_EQ(raw_status(server.port(), "GET / HTTP/1.1\r\nHost: evil.example\r\nRange: " + many + "\r\n\r\n"),
             "HTTP/1.1 416 Range Not Satisfiable");
+  // Ranges it cannot serve: past the file, numbers too long, two dashes, not bytes.
+  for (const char* bad : {"bytes=999999-", "bytes=99999999999999999999999-", "bytes=0-1-2", "bytes=-0", "items=0-1"}) {
+    auto r = cli.Get("/", {{"Range", bad}});
+    ASSERT_TRUE(r) << bad;
+    EXPECT_EQ(r->status, 416) << bad;
+  }
+  auto tail = cli.Get("/", {{"Range", "bytes=-5"}});
+  ASSERT_TRUE(tail);
+  EXPECT_EQ(tail->status, 206);
+  EXPECT_EQ(tail->body.size(), 5u);
 }
 
 // Bound to every interface, it says so; bound to the IPv6 loopback, its URL

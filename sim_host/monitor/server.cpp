@@ -6,7 +6,6 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <condition_variable>
 #include <cstdio>
@@ -55,8 +54,9 @@ using Clock = std::chrono::steady_clock;
 
 // The limits of every request (docs/hil.md, "The monitoring page"): its
 // request line and headers within kHeaderTime and kHeaderBytes; silence (a
-// client that stops reading, or sends nothing) within kIdle; at most
-// kConnections at once, each on its own thread.
+// client that sends nothing, or an event stream's that stops reading)
+// within kIdleSeconds (kStreamIdleSeconds); the connections at once bounded
+// (PageServer's constructor), each on its own thread.
 constexpr auto kHeaderTime = 5s;
 constexpr unsigned kIdleSeconds = 5;
 constexpr unsigned kStreamIdleSeconds = 2;  // an event stream's client that stops reading
@@ -71,7 +71,8 @@ bool parse_range(const std::string& v, std::size_t size, std::size_t* from, std:
   const std::size_t dash = r.find('-');
   if (dash == std::string::npos || r.find_first_not_of("0123456789-") != std::string::npos || r.size() > 40) return false;
   const std::string a = r.substr(0, dash), b = r.substr(dash + 1);
-  if (a.empty() && b.empty()) return false;
+  if ((a.empty() && b.empty()) || a.size() > 18 || b.size() > 18 || b.find('-') != std::string::npos)
+    return false;  // one dash; stoull cannot overflow
   if (a.empty()) {  // the last N bytes
     const std::size_t n = std::stoull(b);
     if (n == 0) return false;
