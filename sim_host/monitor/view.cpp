@@ -70,8 +70,13 @@ std::optional<nlohmann::json> read_meta(const std::string& file, std::size_t col
                                " has " + std::to_string(columns) + " (not the file it was written with)");
     const double rate = j.at("sensor_rate_hz").get<double>();
     if (!(rate > 0 && rate <= 1e6)) throw std::runtime_error(path + ": sensor_rate_hz " + j.at("sensor_rate_hz").dump());
-    j.at("mode").get<std::string>(), j.at("stories").get<int>(), j.at("device").at("kind").get<std::string>();
-    j.at("device").at("floor").get<int>(), j.at("device").at("gap_m").get<double>();
+    const std::string mode = j.at("mode").get<std::string>(), kind = j.at("device").at("kind").get<std::string>();
+    if (mode != "replay" && mode != "twin" && mode != "hybrid") throw std::runtime_error(path + ": mode '" + mode + "'");
+    if (kind != "none" && kind != "tmd" && kind != "vines") throw std::runtime_error(path + ": device kind '" + kind + "'");
+    const int stories = j.at("stories").get<int>(), floor = j.at("device").at("floor").get<int>();
+    if (stories < 1 || stories > 64 || floor < 0 || floor > stories)
+      throw std::runtime_error(path + ": stories " + std::to_string(stories) + ", device floor " + std::to_string(floor));
+    j.at("device").at("gap_m").get<double>();
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
