@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/offline.hpp"
 #include "vines/contact_laws.hpp"
 #include "vines/link/ats.hpp"
@@ -150,6 +151,17 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   if (o.mode == HilMode::kTwin) b.twin = make_twin_bench(sc, o, b.ex);
   b.image = b.cfg.estimator == link::TwinEstimator::kKalman ? b.twin.design.image : model_image(b.cfg, sc.path);
   return b;
+}
+
+DeviceLayout device_layout(const Scene& scene) {
+  const DeviceKind kind = scene.params.device.kind;
+  DeviceLayout d;
+  if (kind == DeviceKind::kNone) return d;
+  const ModelInfo info = build_engine(scene.params, scene.scalar, scene.path)->info();
+  d.kind = kind == DeviceKind::kTmd ? "tmd" : "vines";
+  d.floor = info.device_floor;
+  if (kind == DeviceKind::kVines) d.gap_m = info.vines.gap;
+  return d;
 }
 
 }  // namespace vines::host

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "sim_host/hil/link/boards.hpp"
 #include "sim_host/hil/modes/twin.hpp"
 #include "sim_host/hil/options.hpp"
+#include "sim_host/hil/report.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "vines/link/config.hpp"
@@ -29,5 +31,8 @@ struct Bench {
 
 // Throws std::runtime_error naming the input (scene, option, node).
 Bench make_bench(const Scene& scene, const HilOptions& opt);
+
+// The scene's device (report.hpp's DeviceLayout), as its model designs it.
+DeviceLayout device_layout(const Scene& scene);
 
 }  // namespace vines::host

@@ -5,7 +5,6 @@
 
 #include <memory>
 
-#include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/bench.hpp"
 #include "sim_host/hil/faults.hpp"
 #include "sim_host/hil/link/stream.hpp"
@@ -51,12 +50,7 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch) {
                                  b.opt.floors);
     meta.mode = hil_mode_name(b.opt.mode), meta.scene = b.scene.path, meta.rate_hz = 1 / b.h;
     meta.stories = b.scene.params.frame.stories, meta.floors = b.opt.floors;
-    const DeviceKind dev = b.scene.params.device.kind;
-    if (dev != DeviceKind::kNone) {
-      const ModelInfo info = build_engine(b.scene.params, b.scene.scalar, b.scene.path)->info();
-      meta.device = dev == DeviceKind::kTmd ? "tmd" : "vines", meta.device_floor = info.device_floor;
-      if (dev == DeviceKind::kVines) meta.gap_m = info.vines.gap;
-    }
+    meta.device = device_layout(b.scene);
     write_hil_csv_meta(b.opt.csv, meta);
   }
   if (watch) watch->finish(report);

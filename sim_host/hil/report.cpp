@@ -1,6 +1,7 @@
 #include "sim_host/hil/report.hpp"
 
 #include <cmath>
+#include <iterator>
 
 #include "sim_host/hil/record.hpp"
 #include "sim_host/io/csv.hpp"
@@ -177,19 +178,19 @@ json to_json(const HilReport& r) {
 int write_hil_csv(const std::string& path, const HilRecord& rec, const std::vector<link::Telemetry>& offline,
                   int stories, double h, const CsvColumns& extra, const std::vector<int>& floors) {
   CsvWriter f(path);
-  int columns = 17;
+
   const bool hybrid = !rec.table_x.empty();
   const int n = stories;
   // Header, then one row per sample (a sample without telemetry: zeros).
-  for (const char* c : {"k", "t_s", "ag_sent_mps2", "ag_used_mps2", "received", "flags", "latency_us", "x_top_m",
-                        "x_top_offline_m", "deviation_m", "acc_top_mps2", "Ee_Js", "particle_x_m", "contact_force_n",
-                        "dissipated_J", "aux", "drift_alarms"})
-    f.raw(c);
+  constexpr const char* kColumns[] = {"k", "t_s", "ag_sent_mps2", "ag_used_mps2", "received", "flags",
+                                      "latency_us", "x_top_m", "x_top_offline_m", "deviation_m", "acc_top_mps2",
+                                      "Ee_Js", "particle_x_m", "contact_force_n", "dissipated_J", "aux", "drift_alarms"};
+  for (const char* c : kColumns) f.raw(c);
   if (hybrid) f.raw("table_x_m").raw("force_measured_n");
   for (const std::string& c : extra.names) f.raw(c);
   for (int fl : floors) f.raw("x_" + std::to_string(fl) + "_m");
   f.end_row();
-  columns += (hybrid ? 2 : 0) + static_cast<int>(extra.names.size() + floors.size());
+  const int columns = static_cast<int>(std::size(kColumns) + (hybrid ? 2 : 0) + extra.names.size() + floors.size());
   constexpr const char* kFull = "%.17g";
   for (long long k = 0; k < rec.samples; ++k) {
     const link::Telemetry& t = rec.tel[k];
@@ -213,7 +214,7 @@ int write_hil_csv(const std::string& path, const HilRecord& rec, const std::vect
 nlohmann::json to_json(const CsvMeta& m) {
   return {{"format", "vines hil --csv"}, {"columns", m.columns},     {"mode", m.mode},
           {"scene", m.scene},            {"sensor_rate_hz", m.rate_hz}, {"stories", m.stories},
-          {"device", {{"kind", m.device}, {"floor", m.device_floor}, {"gap_m", m.gap_m}}},
+          {"device", {{"kind", m.device.kind}, {"floor", m.device.floor}, {"gap_m", m.device.gap_m}}},
           {"floors", m.floors}};
 }
 

@@ -188,10 +188,20 @@ int write_hil_csv(const std::string& path, const HilRecord& rec, const std::vect
 // `vines view`: the format and its column count, the mode, the scene, the
 // sensor rate, the stories, the device (kind, floor, the VI NES box's free
 // travel) and the floors of its x_F_m columns.
+// A device as the page and the --csv's description name it: its kind
+// ("none", "tmd", "vines"), its floor (1-based; 0: none) and the VI NES box's
+// free travel each side [m] (0 otherwise).
+struct DeviceLayout {
+  std::string kind = "none";
+  int floor = 0;
+  double gap_m = 0;
+};
+
 struct CsvMeta {
-  std::string mode, scene, device = "none";
-  double rate_hz = 0, gap_m = 0;
-  int stories = 0, device_floor = 0, columns = 0;
+  std::string mode, scene;
+  double rate_hz = 0;
+  int stories = 0, columns = 0;
+  DeviceLayout device;
   std::vector<int> floors;
 };
 nlohmann::json to_json(const CsvMeta& m);

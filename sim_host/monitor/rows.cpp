@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim_host/engines/build_engine.hpp"
 
 namespace vines::host::monitor {
 
@@ -112,18 +111,20 @@ namespace {
 
 // The device's panel: its kind, the floor it sits on (if on the page) and
 // the VI NES box's walls, as the scene's model designs them.
-void set_device(const Bench& b, PageMeta* m) {
-  const SceneParams& p = b.scene.params;
-  const ModelInfo info = build_engine(p, b.scene.scalar, b.scene.path)->info();
-  m->device = p.device.kind == DeviceKind::kTmd ? "tmd" : "vines";
-  const int f = info.device_floor;
-  if (f == p.frame.stories) m->device_floor_series = "x_top_m";
-  else if (std::find(b.opt.floors.begin(), b.opt.floors.end(), f) != b.opt.floors.end())
-    m->device_floor_series = "x_" + std::to_string(f) + "_m";
-  if (p.device.kind == DeviceKind::kVines) m->gap_m = info.vines.gap;
+void set_device(const Bench& b, const std::vector<std::string>& floors, PageMeta* m) {
+  const DeviceLayout d = device_layout(b.scene);
+  m->device = d.kind;
+  m->device_floor_series = device_floor_series(d.floor, b.scene.params.frame.stories, floors);
+  m->gap_m = d.gap_m;
 }
 
 }  // namespace
+
+std::string device_floor_series(int floor, int stories, const std::vector<std::string>& columns) {
+  if (floor == stories) return "x_top_m";
+  const std::string x = "x_" + std::to_string(floor) + "_m";
+  return std::find(columns.begin(), columns.end(), x) != columns.end() ? x : "";
+}
 
 BenchRows::BenchRows(const Bench& b) : b_(b) {
   const SceneParams& p = b.scene.params;
@@ -155,7 +156,7 @@ BenchRows::BenchRows(const Bench& b) : b_(b) {
   for (const std::string& n : decision_names(factors)) names.push_back(n);
   event_ = event_series(names, device_);
   for (const std::string& n : names) meta_.series.push_back(describe(n, meta_.mode, dev));
-  if (dev != DeviceKind::kNone) set_device(b, &meta_);
+  if (dev != DeviceKind::kNone) set_device(b, floors, &meta_);
 }
 
 void BenchRows::take(long long k, const HilRecord& rec, std::vector<double>* v) {

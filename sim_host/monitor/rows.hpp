@@ -40,6 +40,10 @@ struct PageMeta {
 };
 nlohmann::json to_json(const PageMeta& m);
 
+// The series of the floor a device sits on (1-based), if the page has it:
+// the top floor's, or an x_F_m of `columns`; "" if neither.
+std::string device_floor_series(int floor, int stories, const std::vector<std::string>& columns);
+
 // A series by its --csv column's name, in a mode (replay, twin, hybrid) with
 // a device: its label, unit and panel.
 Series describe(const std::string& name, const std::string& mode, DeviceKind device);

@@ -188,9 +188,7 @@ void load_run(const std::string& path, Hub* hub) {
     m.device = device == DeviceKind::kTmd ? "tmd" : "vines";
     m.device_floor_series = "x_top_m";
     if (meta) {
-      const int f = (*meta)["device"]["floor"];
-      const std::string fs = "x_" + std::to_string(f) + "_m";
-      m.device_floor_series = f == m.stories ? "x_top_m" : col.count(fs) ? fs : "";
+      m.device_floor_series = device_floor_series((*meta)["device"]["floor"], m.stories, header);
       m.gap_m = (*meta)["device"]["gap_m"];
     }
   }

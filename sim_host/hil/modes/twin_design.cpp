@@ -230,8 +230,8 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);
   set[twin::kForceScale] = c.device_mass;
-  set[twin::kLossLow] = -2.0;
-  set[twin::kLossHigh] = 0.9;
+  set[twin::kLossLow] = kTwinLossLow;
+  set[twin::kLossHigh] = kTwinLossHigh;
   set[twin::kPeriod] = h;
   set[twin::kJumpSigma] = t.jump_sigma;
   set[twin::kJumpHold] = std::round(t.jump_hold_s / h);

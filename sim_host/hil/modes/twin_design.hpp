@@ -60,6 +60,10 @@ struct TwinBaselineStats {
   int runs = 0;                            // healthy runs it holds
 };
 
+// The bounds of each loss (1 - eta) the estimator keeps its estimates in:
+// a story up to 3 times stiffer than drawn, down to a tenth of it.
+constexpr double kTwinLossLow = -2.0, kTwinLossHigh = 0.9;
+
 struct TwinDesign {
   std::vector<std::uint8_t> image;
   std::vector<double> innovation_sd;  // steady-state innovation sd per sensor [m/s^2]

@@ -189,7 +189,7 @@ class TwinMode : public BenchMode {
   // at 1 % of its stiffness was named as damage at stories 2 and 6, story 1
   // at 1.42), and its verdict is not to be trusted.
   static std::string caveat(const std::vector<double>& eta) {
-    constexpr double kStiffest = 1.15, kLow = 0.1 + 1e-6;  // eta 0.1: the estimator's bound (loss 0.9)
+    constexpr double kStiffest = 1.15, kLow = 1 - kTwinLossHigh + 1e-6;  // the estimator's bound
     std::string said;
     for (std::size_t i = 0; i < eta.size(); ++i) {
       if (eta[i] <= kStiffest && eta[i] >= kLow) continue;
