@@ -471,6 +471,47 @@ TEST(Server, NoClientStallsThePageOrItsStop) {
   ::close(half);
 }
 
+// An event stream with nothing to read waits out of the server's one thread
+// (suspended): it hears a comment each second and stays past its 2 s
+// silence limit, it gets the next event at once, and a stop while it waits
+// closes it at once (issue 53).
+TEST(Server, AnIdleStreamStaysAndTheStopEndsIt) {
+  Hub hub;
+  auto server = std::make_unique<PageServer>(hub, Address{"127.0.0.1", 0});
+  hub.set_header("event: meta\ndata: {}\n\n");
+  const int s = connect_to(server->port());
+  ASSERT_GE(s, 0);
+  const std::string get = "GET /events HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(server->port()) + "\r\n\r\n";
+  ASSERT_EQ(::send(s, get.data(), get.size(), MSG_NOSIGNAL), static_cast<ssize_t>(get.size()));
+  std::string got;
+  const auto read_for = [&](std::chrono::milliseconds d) {
+    const auto end = Clock::now() + d;
+    timeval tv{0, 50000};
+    ::setsockopt(s, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    char buf[4096];
+    while (Clock::now() < end)
+      if (const ssize_t n = ::recv(s, buf, sizeof buf, 0); n > 0) got.append(buf, static_cast<std::size_t>(n));
+      else if (n == 0) break;
+  };
+  read_for(4500ms);
+  EXPECT_NE(got.find("event: meta"), std::string::npos);
+  std::size_t comments = 0;
+  for (std::size_t at = got.find(":\n\n"); at != std::string::npos; at = got.find(":\n\n", at + 1)) ++comments;
+  EXPECT_GE(comments, 2u) << got;
+  EXPECT_EQ(hub.clients(), 1) << "the idle stream was dropped";
+  const auto t0 = Clock::now();
+  hub.publish("event: frame\ndata: 7\n\n");
+  while (got.find("data: 7") == std::string::npos && Clock::now() - t0 < 2s) read_for(10ms);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 0.3);
+  read_for(300ms);  // suspended again
+  const auto t1 = Clock::now();
+  server->stop(0ms);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t1).count(), 0.5);
+  EXPECT_EQ(hub.clients(), 0);
+  EXPECT_EQ(hub.dropped(), 1);  // it left before the run's end
+  ::close(s);
+}
+
 // `vines view`: a run's CSV back into the page's frames, the same series and
 // samples as live (every 5th at 1 kHz, received only), the hybrid tracking
 // RMS computed as the bench does; a bad cell named with its row and column.

@@ -8,11 +8,13 @@ void Hub::set_header(std::string event) {
   {
     std::lock_guard<std::mutex> lock(m_);
     header_ = std::make_shared<const std::string>(std::move(event));
+    ++changes_;
   }
   cv_.notify_all();
 }
 
 void Hub::append_pending() {
+  if (!pending_.empty()) ++changes_;
   for (std::string& e : pending_) {
     bytes_ += e.size();
     log_.push_back(std::make_shared<const std::string>(std::move(e)));
@@ -40,6 +42,7 @@ void Hub::close() {
     std::lock_guard<std::mutex> lock(m_);
     append_pending();
     closed_ = true;
+    ++changes_;
   }
   cv_.notify_all();
 }
@@ -87,6 +90,12 @@ Hub::Next Hub::next(long long* cursor, std::vector<Event>* out, std::chrono::mil
 void Hub::count_dropped() {
   std::lock_guard<std::mutex> lock(m_);
   ++dropped_;
+}
+
+long long Hub::wait_for_change(long long seen, std::chrono::milliseconds wait) {
+  std::unique_lock<std::mutex> lock(m_);
+  cv_.wait_for(lock, wait, [&] { return changes_ != seen; });
+  return changes_;
 }
 
 bool Hub::wait_until_no_clients(std::chrono::milliseconds wait) {

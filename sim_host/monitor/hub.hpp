@@ -3,7 +3,7 @@
 // the bench nothing. A page opened late reads the history from its start; a
 // client that reads more slowly than the run falls out of the history (which
 // is bounded in bytes) and is dropped; one that stops reading is dropped by
-// its server thread (the socket's write timeout): the bench never waits.
+// the server (its socket's write timeout): the bench never waits.
 #pragma once
 
 #include <chrono>
@@ -49,8 +49,12 @@ class Hub {
   // The events from *cursor on into *out (replacing its contents), *cursor
   // moved past them; waits up to `wait` for one.
   Next next(long long* cursor, std::vector<Event>* out, std::chrono::milliseconds wait);
-  // Counts a client dropped by its server thread (its socket blocked).
+  // Counts a client dropped by the server (its socket blocked).
   void count_dropped();
+  // Waits up to `wait` for a change (the header set, events in, the hub
+  // closed) past `seen` (a value this returned before; 0 at first); returns
+  // the hub's changes so far.
+  long long wait_for_change(long long seen, std::chrono::milliseconds wait);
   // Waits up to `wait` for every client to leave; true if they did.
   bool wait_until_no_clients(std::chrono::milliseconds wait);
   // Waits up to `wait` for a client to have read every event to the end
@@ -77,6 +81,7 @@ class Hub {
   int clients_ = 0;
   int finished_ = 0;  // clients that read to the end
   long long dropped_ = 0;
+  long long changes_ = 0;  // set_header, append_pending with events, close
   std::vector<std::string> pending_;  // the bench's only: waiting for the lock
 };
 

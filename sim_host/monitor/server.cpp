@@ -56,7 +56,7 @@ using Clock = std::chrono::steady_clock;
 // request line and headers within kHeaderTime and kHeaderBytes; silence (a
 // client that sends nothing, or an event stream's that stops reading)
 // within kIdleSeconds (kStreamIdleSeconds); the connections at once bounded
-// (PageServer's constructor), each on its own thread.
+// (PageServer's constructor), all on the server's one thread.
 constexpr auto kHeaderTime = 5s;
 constexpr unsigned kIdleSeconds = 5;
 constexpr unsigned kStreamIdleSeconds = 2;  // an event stream's client that stops reading
@@ -102,8 +102,13 @@ struct PageServer::Impl {
   std::mutex m;
   std::condition_variable cv;
   std::map<MHD_Connection*, Pending> pending;
+  // The event streams waiting for the hub, out of the server's loop (its
+  // one thread never waits): the waker resumes them when the hub changes,
+  // and each second (a stream's keep-alive). None suspends once closing.
+  std::vector<MHD_Connection*> suspended;
+  bool closing = false;
   bool stopping = false;
-  std::thread watchdog;
+  std::thread watchdog, waker;
 
   void watch() {
     std::unique_lock<std::mutex> lock(m);
@@ -114,14 +119,36 @@ struct PageServer::Impl {
         if (!p.cut && now - p.since > kHeaderTime) ::shutdown(p.fd, SHUT_RDWR), p.cut = true;
     }
   }
+
+  // Resumed outside the lock (MHD's own locks are taken by a resume, and its
+  // thread holds them when it asks a stream for bytes): a suspended
+  // connection stays until resumed, so none is freed meanwhile.
+  void wake() {
+    long long seen = 0;
+    auto last = Clock::now();
+    for (;;) {
+      const long long changes = hub.wait_for_change(seen, 50ms);
+      std::vector<MHD_Connection*> now;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (stopping && suspended.empty()) return;
+        if (changes == seen && Clock::now() - last < kKeepAlive && !stopping) continue;
+        now.swap(suspended);
+      }
+      seen = changes, last = Clock::now();
+      for (MHD_Connection* c : now) MHD_resume_connection(c);
+    }
+  }
 };
 
 namespace {
 
 // One client of /events: the hub's events from its cursor, copied into
-// MHD's buffer as it asks for them.
+// MHD's buffer as it asks for them; with none to give, the connection is
+// suspended until the waker resumes it.
 struct Stream {
-  Hub* hub = nullptr;
+  PageServer::Impl* impl = nullptr;
+  MHD_Connection* connection = nullptr;
   long long cursor = 0;
   std::string out;  // bytes not yet given to MHD
   std::size_t at = 0;
@@ -131,19 +158,28 @@ struct Stream {
 
 ssize_t read_stream(void* cls, std::uint64_t, char* buf, std::size_t max) {
   auto* s = static_cast<Stream*>(cls);
+  Hub& hub = s->impl->hub;
   if (s->at == s->out.size()) {
     s->out.clear(), s->at = 0;
     if (s->ended) return MHD_CONTENT_READER_END_OF_STREAM;
     std::vector<Event> events;
-    switch (s->hub->next(&s->cursor, &events, 250ms)) {
+    // The hub asked under the waker's lock: a change after this answer wakes
+    // the stream suspended below.
+    std::unique_lock<std::mutex> lock(s->impl->m);
+    switch (hub.next(&s->cursor, &events, 0ms)) {
       case Hub::Next::kEnd: s->ended = true; return MHD_CONTENT_READER_END_OF_STREAM;
       case Hub::Next::kBehind:
-        s->hub->count_dropped(), s->ended = true;
+        hub.count_dropped(), s->ended = true;
         return MHD_CONTENT_READER_END_WITH_ERROR;
       case Hub::Next::kIdle:
         // A comment now and then, so that a client still reading is told
         // apart from one that stopped (whose socket fills).
-        if (Clock::now() - s->last < kKeepAlive) return 0;
+        if (Clock::now() - s->last < kKeepAlive) {
+          if (s->impl->closing) return MHD_CONTENT_READER_END_WITH_ERROR;
+          s->impl->suspended.push_back(s->connection);
+          MHD_suspend_connection(s->connection);
+          return 0;
+        }
         s->out = ":\n\n";
         break;
       case Hub::Next::kEvents:
@@ -162,8 +198,8 @@ ssize_t read_stream(void* cls, std::uint64_t, char* buf, std::size_t max) {
 // and timed out, or closed) counts as dropped.
 void free_stream(void* cls) {
   auto* s = static_cast<Stream*>(cls);
-  if (!s->ended) s->hub->count_dropped();
-  s->hub->leave();
+  if (!s->ended) s->impl->hub.count_dropped();
+  s->impl->hub.leave();
   delete s;
 }
 
@@ -226,8 +262,9 @@ PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Imp
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&bound), &len);
   port_ = ntohs(v6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
 
-  // One thread a connection (an event stream waits on the hub in its own),
-  // under the limits above; the watchdog's list kept by the notifier.
+  // One thread for every connection (epoll; an event stream waiting for the
+  // hub is suspended, not waited on), under the limits above; the
+  // watchdog's list kept by the notifier.
   const auto notify = +[](void* cls, MHD_Connection* c, void**, MHD_ConnectionNotificationCode toe) {
     auto* impl = static_cast<Impl*>(cls);
     std::lock_guard<std::mutex> lock(impl->m);
@@ -254,7 +291,7 @@ PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Imp
   };
   const unsigned limit = 2 * static_cast<unsigned>(hub.limits().max_clients) + 56;  // 64 with 4 clients
   impl_->daemon = MHD_start_daemon(
-      MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL | (v6 ? MHD_USE_IPv6 : 0), 0,
+      MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | (v6 ? MHD_USE_IPv6 : 0), 0,
       nullptr, nullptr, answer, this, MHD_OPTION_LISTEN_SOCKET, fd, MHD_OPTION_CONNECTION_TIMEOUT, kIdleSeconds,
       MHD_OPTION_CONNECTION_LIMIT, limit, MHD_OPTION_CONNECTION_MEMORY_LIMIT, kHeaderBytes,
       MHD_OPTION_NOTIFY_CONNECTION, notify, impl_.get(), MHD_OPTION_END);
@@ -263,6 +300,7 @@ PageServer::PageServer(Hub& hub, const Address& at) : impl_(std::make_unique<Imp
     throw std::runtime_error(where + ": the HTTP server (libmicrohttpd) did not start");
   }
   impl_->watchdog = std::thread([this] { impl_->watch(); });
+  impl_->waker = std::thread([this] { impl_->wake(); });
   if (!loopback())
     std::fprintf(stderr,
                  "--serve %s: the page is open to every machine that can reach this one on port %d (read-only, no "
@@ -291,7 +329,7 @@ int PageServer::answer(MHD_Connection* c, const char* url_c, const char* method_
     const std::optional<long long> joined = impl_->hub.join();
     if (!joined) return queue(c, MHD_HTTP_SERVICE_UNAVAILABLE, text("too many clients of this page\n"));
     auto* s = new Stream;
-    s->hub = &impl_->hub, s->cursor = *joined;
+    s->impl = impl_.get(), s->connection = c, s->cursor = *joined;
     MHD_Response* r = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, 64 * 1024, read_stream, s, free_stream);
     MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
     MHD_add_response_header(r, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
@@ -347,19 +385,22 @@ PageServer::~PageServer() { stop(std::chrono::milliseconds(0)); }
 std::string PageServer::url() const { return "http://" + authority() + "/"; }
 
 // The daemon's stop closes every connection, a client's half-sent request
-// or unread stream included: it never waits on a client.
+// or unread stream included: it never waits on a client. No stream may be
+// suspended then (MHD aborts): none suspends once closing, the waker
+// resumes the last ones and ends.
 void PageServer::stop(std::chrono::milliseconds linger, bool hold) {
   if (!impl_->daemon) return;
   if (hold) impl_->hub.wait_until_read(linger);
   else impl_->hub.wait_until_no_clients(linger);
-  MHD_stop_daemon(impl_->daemon);
-  impl_->daemon = nullptr;
   {
     std::lock_guard<std::mutex> lock(impl_->m);
-    impl_->stopping = true;
+    impl_->closing = impl_->stopping = true;
   }
   impl_->cv.notify_all();
+  impl_->waker.join();
   impl_->watchdog.join();
+  MHD_stop_daemon(impl_->daemon);
+  impl_->daemon = nullptr;
 }
 
 }  // namespace vines::host::monitor

@@ -1,5 +1,5 @@
-// The page's HTTP server, on libmicrohttpd (its own threads, one a
-// connection): GET of the page's files and of /events, the hub's events as
+// The page's HTTP server, on libmicrohttpd (one thread of its own for every
+// connection, epoll): GET of the page's files and of /events, the hub's events as
 // Server-Sent Events; any other method refused (405): nothing on the page can
 // change the run. Every request is bounded: its headers in time and bytes, its
 // silence, the connections at once; stopping closes every connection.
@@ -27,6 +27,7 @@ Address parse_address(const std::string& option, const std::string& value);
 
 class PageServer {
  public:
+  struct Impl;  // server.cpp's: the daemon, its watchdog and its streams' waker
   // Listens at once (the port known when this returns) and serves on its
   // own threads; throws std::runtime_error naming the address if it cannot.
   // Bound beyond loopback, it says so on stderr. One request a connection,
@@ -50,7 +51,6 @@ class PageServer {
   int answer(MHD_Connection* c, const char* url, const char* method);  // an MHD_Result
   bool loopback() const;
   bool host_allowed(const std::string& host) const;
-  struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string host_;
   int port_ = 0;
