@@ -1,9 +1,9 @@
 # The contact-law registry for CMake: the lines of its table (`    laws::Name,`
-# in firmware/include/vines/contact_laws.hpp, in the order of the laws'
+# in firmware/include/vines/model/contact_laws.hpp, in the order of the laws'
 # codes). Read by the host's engine instances (sim_host/CMakeLists.txt) and
 # the board's node images (firmware/app/CMakeLists.txt); editing the table
 # reconfigures.
-set(VINES_LAWS_HEADER ${CMAKE_CURRENT_LIST_DIR}/../firmware/include/vines/contact_laws.hpp)
+set(VINES_LAWS_HEADER ${CMAKE_CURRENT_LIST_DIR}/../firmware/include/vines/model/contact_laws.hpp)
 
 # vines_contact_laws(<structs> <names>): the laws' struct names (Kuwabara) and
 # their lower-case names (kuwabara, the scene's vines.law), in the table's order.

@@ -9,8 +9,10 @@ Layers (see the README of each folder):
                                   that neither allocate nor touch the OS
   hal facade  hal/include         its own headers and those same C++ headers
   board app   firmware/app        core, HAL facades, its own files, same C++
-  mcu backend hal/mcu             core, HAL facades, its own files (any C/C++
-                                  header: the link proves there is no heap)
+  mcu backend hal/mcu             HAL facades, its own files (any C/C++
+                                  header: the link proves there is no heap);
+                                  not the core: hal/ stands below it
+  mcu tests   tests/mcu           core, HAL facades, hal/mcu, its own files
   core tests  tests/core          core, its own files, the link fuzz body
                                   (tests/fuzz), GoogleTest and the C++ standard
                                   library: no host code, no other library
@@ -24,6 +26,11 @@ files and the rooms below it; no source file outside a room, no room of more
 than 20 source files:
   io < scene < engines < run < reference < studies < bench, hil (hil/, hil/link/,
   hil/modes/: one bench) < python, monitor (the page, on hil) < cli
+
+Inside the firmware, the rooms are each folder of firmware/include/vines/,
+each header standing alone there, and firmware/app: no loop of includes
+between them, and at most FIRMWARE_FLOORS floors (the longest chain of
+includes between rooms).
 
 No contact law is named outside its registry (firmware/include/vines/
 contact_laws.hpp; params.hpp holds the codes): the product's code (firmware/,
@@ -54,7 +61,8 @@ LAYERS = [
     ("core", "firmware/include", ["firmware/include"], core_angle),
     ("hal facade", "hal/include", ["hal/include"], core_angle),
     ("board app", "firmware/app", ["firmware/include", "hal/include"], core_angle),
-    ("mcu backend", "hal/mcu", ["firmware/include", "hal/include"], lambda name: True),
+    ("mcu backend", "hal/mcu", ["hal/include"], lambda name: True),
+    ("mcu tests", "tests/mcu", ["firmware/include", "hal/include", "hal/mcu"], lambda name: True),
     ("core tests", "tests/core", ["firmware/include", "tests/fuzz"], core_test_angle),
 ]
 HOST_PREFIXES = ("sim_host/", "hal/host/", "host/")
@@ -99,8 +107,53 @@ def check_rooms(root):
     return problems
 
 
+FIRMWARE_FLOORS = 8
+CORE_INCLUDE = re.compile(r'^\s*#\s*include\s*"vines/([^"]+)"')
+
+
+def firmware_rooms(root):
+    """The firmware's rooms and the includes between them: {room: {room: 'file: include'}}."""
+    top, arrows = os.path.join(root, "firmware", "include", "vines"), {}
+    found = [(path, os.path.relpath(path, top).split(os.sep)[0]) for path in walk_sources(top)]
+    found += [(path, "app") for path in walk_sources(os.path.join(root, "firmware", "app"))]
+    for path, room in found:
+        arrows.setdefault(room, {})
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                m = CORE_INCLUDE.match(line)
+                target = m.group(1).split("/")[0] if m else room
+                if target != room and not target.startswith("hal"):
+                    arrows[room].setdefault(target, f"{os.path.relpath(path, root)}: {m.group(0).strip()}")
+    return arrows
+
+
+def walk_sources(top):
+    for dirpath, _, names in os.walk(top):
+        yield from (os.path.join(dirpath, n) for n in sorted(names) if n.endswith(SOURCE))
+
+
+def check_firmware_rooms(root):
+    """No loop of includes between the firmware's rooms; at most FIRMWARE_FLOORS floors."""
+    arrows, floors, problems = firmware_rooms(root), {}, []
+
+    def floor(room, path):
+        if room in path:  # a loop: the path from room back to it
+            loop = path[path.index(room):] + [room]
+            problems.append("firmware rooms loop: " + " -> ".join(loop) + " (" +
+                            "; ".join(arrows[a][b] for a, b in zip(loop, loop[1:])) + ")")
+            return 0
+        if room not in floors:
+            floors[room] = 1 + max((floor(t, path + [room]) for t in arrows.get(room, {})), default=0)
+        return floors[room]
+
+    highest = max((floor(room, []) for room in sorted(arrows)), default=0)
+    if not problems and highest > FIRMWARE_FLOORS:
+        problems.append(f"firmware rooms: {highest} floors (at most {FIRMWARE_FLOORS})")
+    return sorted(set(problems)), highest
+
+
 LAW_NAMED = re.compile(r"ContactLaw::k[A-Z]|laws::[A-Z][a-z]")
-LAW_REGISTRY = ("firmware/include/vines/contact_laws.hpp", "firmware/include/vines/params.hpp")
+LAW_REGISTRY = ("firmware/include/vines/model/contact_laws.hpp", "firmware/include/vines/model/params.hpp")
 
 
 def check_laws(root):
@@ -143,7 +196,9 @@ def check_file(root, layer, folder, roots, angle_ok, path):
                 found = os.path.exists(os.path.join(here, name)) and \
                     os.path.realpath(os.path.join(here, name)).startswith(os.path.realpath(os.path.join(root, folder)))
                 found = found or any(os.path.exists(os.path.join(root, r, name)) for r in roots)
-                if not found:
+                if not found and folder.startswith("hal/") and os.path.exists(os.path.join(root, "firmware/include", name)):
+                    problems.append(f"{where}: hal/ must not include the core (a test program goes in tests/mcu/)")
+                elif not found:
                     problems.append(f"{where}: not found in {', '.join(dict.fromkeys([folder] + roots))}")
     return problems
 
@@ -163,9 +218,11 @@ def main(argv):
                     problems += check_file(root, layer, folder, roots, angle_ok, os.path.join(dirpath, name))
     problems += check_rooms(root)
     problems += check_laws(root)
+    loops, floors = check_firmware_rooms(root)
+    problems += loops
     for p in problems:
         print(p)
-    print(f"check_layers: {files} files, {len(problems)} problems")
+    print(f"check_layers: {files} files, {len(problems)} problems; the firmware's rooms on {floors} floors")
     return 1 if problems else 0
 
 

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "vines/build_model.hpp"
-#include "vines/frame_presets.hpp"
-#include "vines/model_image.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/step/sim.hpp"
 
 static_assert(VINES_MODAL_LANES == 1, "this check is the unpadded build");
 

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "support.hpp"
-#include "vines/build_model.hpp"
-#include "vines/model_image.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines::image_test {
 

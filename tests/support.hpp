@@ -9,7 +9,7 @@
 
 #include "host/record.hpp"
 #include "sim_host/engines/engine.hpp"
-#include "vines/frame_presets.hpp"
+#include "vines/model/frame_presets.hpp"
 
 namespace vines::test {
 

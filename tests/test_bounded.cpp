@@ -17,7 +17,7 @@
 #include "scene_support.hpp"
 #include "support.hpp"
 #include "vines/link/config.hpp"
-#include "vines/substep_bounded.hpp"
+#include "vines/step/substep_bounded.hpp"
 
 namespace {
 

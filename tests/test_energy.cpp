@@ -5,8 +5,8 @@
 #include <tuple>
 
 #include "support.hpp"
-#include "vines/build_model.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/step/sim.hpp"
 
 namespace {
 

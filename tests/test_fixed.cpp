@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "support.hpp"
-#include "vines/build_model.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/fixed/modal.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
-#include "vines/numeric/fixed_modal.hpp"
 
 namespace vines {
 namespace {

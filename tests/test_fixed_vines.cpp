@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "support.hpp"
-#include "vines/build_model.hpp"
+#include "vines/build/build_model.hpp"
 #include "vines/fixed/vines_step.hpp"
 
 namespace vines {

@@ -11,11 +11,11 @@
 
 #include "sim_host/hil/hil.hpp"
 #include "sim_host/hil/link/child.hpp"
-#include "vines/frame_presets.hpp"
 #include "vines/link/ats.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
 #include "vines/link/messages.hpp"
+#include "vines/model/frame_presets.hpp"
 
 namespace vines::host {
 namespace {

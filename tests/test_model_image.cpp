@@ -1,4 +1,4 @@
-// Model images (vines/model_image.hpp): a model built on the host, written as
+// Model images (vines/image/model_image.hpp): a model built on the host, written as
 // an image and loaded through the streaming Loader in chunks of any size
 // steps bit for bit like the model built in place (every device and law,
 // double and float, 10 stories, El Centro); padding stays out of the image;
@@ -23,8 +23,8 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "support.hpp"
-#include "vines/model_image.hpp"
-#include "vines/sim.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines {
 namespace {

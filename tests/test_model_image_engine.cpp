@@ -19,8 +19,8 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "support.hpp"
-#include "vines/model_image.hpp"
-#include "vines/sim.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines {
 namespace {

@@ -1,4 +1,4 @@
-// Model images (vines/model_image.hpp) refused: corrupt, truncated, too long
+// Model images (vines/image/model_image.hpp) refused: corrupt, truncated, too long
 // and mismatched images (scalar, story count, device, law, field list) are
 // refused and never leave the loader ready.
 #include <gtest/gtest.h>
@@ -19,9 +19,9 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/scene/scene.hpp"
 #include "support.hpp"
-#include "vines/build_model.hpp"
-#include "vines/model_image.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines {
 namespace {

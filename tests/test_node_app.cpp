@@ -15,9 +15,9 @@
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/modes/plant.hpp"
 #include "support.hpp"
-#include "vines/build_model.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/image/model_image.hpp"
 #include "vines/link/model_plant.hpp"
-#include "vines/model_image.hpp"
 
 namespace vines::test {
 namespace {

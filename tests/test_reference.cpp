@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "sim_host/bench/bench.hpp"
 #include "sim_host/reference/ode.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/reference/spec.hpp"
@@ -20,10 +21,9 @@
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/frame.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/bench/bench.hpp"
 #include "reference_support.hpp"
 #include "support.hpp"
-#include "vines/frame.hpp"
+#include "vines/model/frame.hpp"
 
 namespace {
 

@@ -10,15 +10,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim_host/bench/bench.hpp"
 #include "sim_host/reference/report.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/run/run.hpp"
 #include "sim_host/scene/frame.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/bench/bench.hpp"
 #include "reference_support.hpp"
 #include "support.hpp"
-#include "vines/frame.hpp"
+#include "vines/model/frame.hpp"
 
 namespace {
 

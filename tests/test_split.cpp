@@ -17,8 +17,8 @@
 #include "reference_support.hpp"
 #include "scene_support.hpp"
 #include "support.hpp"
-#include "vines/devices.hpp"
 #include "vines/link/config.hpp"
+#include "vines/model/devices.hpp"
 
 namespace {
 

@@ -12,7 +12,7 @@
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/run/drive.hpp"
 #include "sim_host/studies/parallel.hpp"
-#include "vines/contact_laws.hpp"
+#include "vines/model/contact_laws.hpp"
 
 namespace vines::host {
 namespace {

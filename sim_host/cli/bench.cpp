@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "sim_host/bench/bench.hpp"
+#include "sim_host/bench/ensemble.hpp"
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/io/csv.hpp"
 #include "sim_host/reference/truth.hpp"
 #include "sim_host/scene/scene.hpp"
-#include "sim_host/bench/bench.hpp"
-#include "sim_host/bench/ensemble.hpp"
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::cli {
 namespace {

@@ -11,9 +11,9 @@
 #include "sim_host/io/output.hpp"
 #include "sim_host/scene/names.hpp"
 #include "sim_host/scene/scene.hpp"
+#include "vines/bytes/crc32.hpp"
 #include "vines/fixed/image.hpp"
-#include "vines/link/crc32.hpp"
-#include "vines/model_image.hpp"
+#include "vines/image/model_image.hpp"
 
 namespace vines::cli {
 namespace {
@@ -67,7 +67,7 @@ void add_image(CLI::App& vines) {
   auto a = std::make_shared<ImageArgs>();
   CLI::App* cmd = add_command(vines, "image",
                               "Build the scene's model on this host and write its model image: what a board loads "
-                              "instead of building the model itself (format: firmware/include/vines/model_image.hpp; "
+                              "instead of building the model itself (format: firmware/include/vines/image/model_image.hpp; "
                               "in fixed point firmware/include/vines/fixed/image.hpp). "
                               "Prints its size, version, scalar, stories, device and CRC. The record is not read.",
                               "", [a] { return image(*a); });

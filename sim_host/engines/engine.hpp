@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "sim_host/scene/scalar.hpp"
-#include "vines/data.hpp"
-#include "vines/params.hpp"
-#include "vines/validate.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/params.hpp"
+#include "vines/model/validate.hpp"
 
 namespace vines::host {
 
@@ -96,7 +96,7 @@ class Engine {
   // for bit, the one build(p) makes when p differs from the built parameters
   // in nothing else. Call init() after it.
   virtual ParamError set_initial_conditions(const SceneParams& p) = 0;
-  // The model's image (vines/model_image.hpp), after build() or load_image().
+  // The model's image (vines/image/model_image.hpp), after build() or load_image().
   virtual std::vector<std::uint8_t> model_image() const = 0;
   // Loads a model image in place of building: empty on success, after which
   // init/step/run work as after build(); else why it was refused (the model
@@ -125,7 +125,7 @@ class Engine {
   // was refused (not a loop state, truncated, another scalar, story count,
   // device or model), the current state then untouched.
   virtual std::string load_state(const std::uint8_t* p, std::size_t n) = 0;
-  // Puts the loop in a physical state (vines/set_state.hpp): the floors
+  // Puts the loop in a physical state (vines/step/set_state.hpp): the floors
   // solved for the linear state in double, the VI NES particle in free
   // flight, strictly between the walls. The clock, peaks and counters are
   // kept, E_e so far too (it goes on from the new state); with the energy

@@ -17,10 +17,10 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/engines/loop_state.hpp"
 #include "sim_host/engines/model_info.hpp"
-#include "vines/build_model.hpp"
-#include "vines/model_image.hpp"
-#include "vines/set_state.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/image/model_image.hpp"
+#include "vines/step/set_state.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines::host {
 

@@ -24,11 +24,11 @@
 #include "sim_host/engines/engine.hpp"
 #include "sim_host/engines/loop_state.hpp"
 #include "sim_host/engines/model_info.hpp"
-#include "vines/build_model.hpp"
-#include "vines/contact_laws.hpp"
+#include "vines/build/build_model.hpp"
 #include "vines/fixed/image.hpp"
 #include "vines/fixed/node_model.hpp"
-#include "vines/sim.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines::host {
 

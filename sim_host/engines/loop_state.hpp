@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "sim_host/scene/scalar.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/devices.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/devices.hpp"
 
 namespace vines::host::loop_state {
 

@@ -7,7 +7,7 @@
 // (instance.cpp.in, stress_instances.cpp.in: EXT extern).
 #pragma once
 
-#include "vines/build_model.hpp"
+#include "vines/build/build_model.hpp"
 
 // S-independent: the frame and its modes.
 #define VINES_FRAME_BUILDERS(EXT, N)                                                      \

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "sim_host/engines/engine.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 
 namespace vines::host {
 

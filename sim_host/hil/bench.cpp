@@ -8,14 +8,14 @@
 
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/hil/offline.hpp"
-#include "vines/contact_laws.hpp"
 #include "vines/link/ats.hpp"
+#include "vines/model/contact_laws.hpp"
 
 namespace vines::host {
 namespace {
 
 // "hertz, tsuji or kuwabara": the laws of finite contact duration, from the
-// registry (vines/contact_laws.hpp).
+// registry (vines/model/contact_laws.hpp).
 std::string finite_laws() {
   std::vector<std::string> names;
   each_law([&](auto law) {

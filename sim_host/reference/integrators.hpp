@@ -10,7 +10,7 @@
 #include "sim_host/reference/ode.hpp"
 #include "sim_host/reference/spec.hpp"
 #include "sim_host/reference/truth.hpp"
-#include "vines/contact_mode.hpp"
+#include "vines/model/contact_mode.hpp"
 
 namespace vines::host::reference {
 

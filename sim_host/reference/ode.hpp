@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "sim_host/reference/spec.hpp"
-#include "vines/contact.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/contact_mode.hpp"
+#include "vines/model/contact.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/contact_mode.hpp"
 
 namespace vines::host::reference {
 

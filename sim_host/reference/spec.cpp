@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "vines/validate.hpp"
+#include "vines/model/validate.hpp"
 
 namespace vines::host::reference {
 namespace {

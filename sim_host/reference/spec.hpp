@@ -4,8 +4,8 @@
 #pragma once
 
 #include "sim_host/scene/frame.hpp"
-#include "vines/devices.hpp"
-#include "vines/params.hpp"
+#include "vines/model/devices.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host::reference {
 

@@ -21,7 +21,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host::reference {
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "sim_host/reference/ode.hpp"
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host::reference {
 

@@ -1,12 +1,12 @@
 // The shear frame at run-time size, for host code that cannot take the story
 // count as a template argument (the scene limits, the reference integrators, the
 // twin's design). Same construction as the firmware's build_frame<N>
-// (vines/frame.hpp), in double.
+// (vines/model/frame.hpp), in double.
 #pragma once
 
 #include <vector>
 
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "sim_host/scene/frame.hpp"
-#include "vines/devices.hpp"
+#include "vines/model/devices.hpp"
 
 namespace vines::host {
 namespace {

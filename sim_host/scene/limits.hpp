@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

@@ -1,5 +1,5 @@
 // Names of the model's choices as scene files and outputs spell them (a
-// contact law's: law_name, vines/contact_laws.hpp).
+// contact law's: law_name, vines/model/contact_laws.hpp).
 #pragma once
 
 #include <optional>
@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "host/record.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/params.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

@@ -17,7 +17,7 @@
 //   [vines]   radius_m, density_kg_m3, young_pa, poisson, wall_young_pa,
 //             wall_poisson, beta | box_length_m (not both),
 //             law = "kuwabara" | "tsuji" | "hertz" | "restitution" (the
-//             laws of vines/contact_laws.hpp), eps,
+//             laws of vines/model/contact_laws.hpp), eps,
 //             v_ref_mps | tau_s (not both), initial_position_m,
 //             initial_velocity_mps. Without initial_position_m the particle
 //             starts against the left wall.
@@ -67,9 +67,9 @@
 #include "sim_host/scene/names.hpp"
 #include "sim_host/scene/section.hpp"
 #include "sim_host/scene/table.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/frame_presets.hpp"
-#include "vines/validate.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/model/validate.hpp"
 
 namespace vines::host {
 namespace {
@@ -77,7 +77,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace scene_detail;
 
-// The contact laws a scene may name: the registry's (vines/contact_laws.hpp).
+// The contact laws a scene may name: the registry's (vines/model/contact_laws.hpp).
 Choices<ContactLaw> law_choices() {
   Choices<ContactLaw> out;
   each_law([&](auto law) { out.emplace_back(decltype(law)::kName, decltype(law)::kTag); });

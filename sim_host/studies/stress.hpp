@@ -17,7 +17,7 @@
 
 #include "host/record.hpp"
 #include "sim_host/scene/scalar.hpp"
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

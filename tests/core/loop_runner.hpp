@@ -1,4 +1,4 @@
-// Runs the firmware loop directly (Model and Data of vines/sim.hpp), as a
+// Runs the firmware loop directly (Model and Data of vines/step/sim.hpp), as a
 // board does: no host engine, no record reader. Core tests drive it with
 // analytic inputs.
 #pragma once
@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "vines/build_model.hpp"
-#include "vines/frame_presets.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/step/sim.hpp"
 
 namespace vines::core_test {
 

@@ -7,13 +7,13 @@
 #include <string>
 #include <type_traits>
 
-#include "vines/bounce.hpp"
-#include "vines/contact.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/devices.hpp"
-#include "vines/frame.hpp"
-#include "vines/frame_presets.hpp"
-#include "vines/validate.hpp"
+#include "vines/model/bounce.hpp"
+#include "vines/model/contact.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/devices.hpp"
+#include "vines/model/frame.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/model/validate.hpp"
 
 namespace {
 

@@ -8,11 +8,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "vines/bounce.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/devices.hpp"
 #include "vines/fixed/bounce.hpp"
 #include "vines/fixed/contact.hpp"
+#include "vines/model/bounce.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/devices.hpp"
 #include "vines/numeric/fixed.hpp"
 
 namespace {

@@ -1,5 +1,5 @@
 // The frame's response to a contact force from the force's moments
-// (vines/fixed/force_moments.hpp), on the paper's 10-story frame with a VI
+// (vines/split/force_moments.hpp), on the paper's 10-story frame with a VI
 // NES: a half-sine pulse (the shape of a contact force) inside a step,
 // against the modal equations integrated with 200,000 Runge-Kutta steps.
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "vines/build_model.hpp"
-#include "vines/fixed/force_moments.hpp"
-#include "vines/frame_presets.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/split/force_moments.hpp"
 
 namespace {
 

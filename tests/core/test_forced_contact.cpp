@@ -1,4 +1,4 @@
-// The split contact step (vines/fixed/forced_contact.hpp) on a 2-DOF
+// The split contact step (vines/split/forced_contact.hpp) on a 2-DOF
 // problem: the paper's sphere (55.8 t, Kuwabara, eps 0.7 at 0.5 m/s) hits
 // the wall of a 98 t floor on a spring to the ground (5 Hz, 2 % damping)
 // that is already moving. The split: per 1 ms sensor step, the overlap's
@@ -13,13 +13,13 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_laws.hpp"
-#include "vines/devices.hpp"
 #include "vines/fixed/contact_coupling.hpp"
-#include "vines/fixed/contact_step.hpp"
-#include "vines/fixed/forced_contact.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/devices.hpp"
 #include "vines/numeric/expm.hpp"
 #include "vines/numeric/fixed.hpp"
+#include "vines/split/contact_step.hpp"
+#include "vines/split/forced_contact.hpp"
 
 namespace {
 
@@ -154,7 +154,7 @@ Outcome split(const TwoBodies& su, double v0, double x0, double vf0, double dw) 
 
 // The overlap's equation in the contact's units (fixed/contact_coupling.hpp:
 // V bounds the impact speed, the moments' arm in units of the sensor step)
-// and the scalar S, stepped by the loop's rule (fixed/contact_step.hpp, n
+// and the scalar S, stepped by the loop's rule (split/contact_step.hpp, n
 // steps an impact, dw at most 1); *steps counts its Runge-Kutta steps.
 template <typename S>
 Outcome split_in_units(const TwoBodies& su, double v0, double x0, double vf0, int n, int* steps) {

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "vines/devices.hpp"
-#include "vines/frame.hpp"
-#include "vines/frame_presets.hpp"
+#include "vines/model/devices.hpp"
+#include "vines/model/frame.hpp"
+#include "vines/model/frame_presets.hpp"
 
 namespace {
 

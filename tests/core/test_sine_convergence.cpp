@@ -1,5 +1,5 @@
 // Convergence of the fixed-step loop against analytic inputs, on the core
-// alone (the loop of vines/sim.hpp, no host engine). The linear part is
+// alone (the loop of vines/step/sim.hpp, no host engine). The linear part is
 // discretised exactly for a ground acceleration that is linear between
 // samples, so
 //  - with a smooth ground motion, the only error is the linear interpolation
@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "loop_runner.hpp"
-#include "vines/frame.hpp"
+#include "vines/model/frame.hpp"
 
 namespace {
 

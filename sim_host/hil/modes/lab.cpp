@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "vines/contact_laws.hpp"
+#include "vines/model/contact_laws.hpp"
 
 namespace vines::host {
 

@@ -17,8 +17,8 @@
 #include <deque>
 #include <random>
 
-#include "vines/devices.hpp"
-#include "vines/params.hpp"
+#include "vines/model/devices.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

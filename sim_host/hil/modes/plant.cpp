@@ -5,7 +5,7 @@
 #include <string>
 
 #include "sim_host/engines/build_engine.hpp"
-#include "vines/lti_build.hpp"
+#include "vines/build/lti_build.hpp"
 
 namespace vines::host {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "sim_host/hil/modes/twin_model_error.hpp"
 #include "sim_host/scene/frame.hpp"
-#include "vines/link/wire.hpp"
+#include "vines/bytes/wire.hpp"
 #include "vines/numeric/expm.hpp"
 #include "vines/twin/image.hpp"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "sim_host/engines/engine.hpp"
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::host {
 

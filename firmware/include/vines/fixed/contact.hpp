@@ -21,7 +21,7 @@
 
 #include <cmath>
 
-#include "vines/contact.hpp"
+#include "vines/model/contact.hpp"
 #include "vines/numeric/fixed.hpp"
 
 namespace vines::fixed {

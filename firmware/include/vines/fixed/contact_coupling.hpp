@@ -1,4 +1,4 @@
-// The split contact step's overlap equation (fixed/forced_contact.hpp) in
+// The split contact step's overlap equation (split/forced_contact.hpp) in
 // the units of a contact (fixed/contact.hpp: overlap D, speed V, time
 // T = D / V, force m V^2 / D, m the particle's mass), where every one of its
 // quantities is O(1) and fits Q3.28, with the moments' lever arm in a unit
@@ -16,7 +16,7 @@
 #include <cmath>
 
 #include "vines/fixed/contact.hpp"
-#include "vines/fixed/forced_contact.hpp"
+#include "vines/split/forced_contact.hpp"
 
 namespace vines::fixed {
 

@@ -1,5 +1,5 @@
 // The frame in fixed point (issue 34, docs/fixed_point.md): the modal exact
-// step in each mode's own units (numeric/fixed_modal.hpp), the top floor's
+// step in each mode's own units (fixed/modal.hpp), the top floor's
 // peak and E_e, for the bare frame and under the VI NES
 // (fixed/vines_model.hpp). Built once, in double, from the double model;
 // the step has no double in it.
@@ -18,10 +18,10 @@
 #include <Eigen/Core>
 
 #include "vines/fixed/ledger.hpp"
-#include "vines/model.hpp"
+#include "vines/fixed/modal.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
-#include "vines/numeric/fixed_modal.hpp"
 
 namespace vines::fixed {
 

@@ -21,8 +21,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "vines/link/crc32.hpp"
-#include "vines/link/wire.hpp"
+#include "vines/bytes/crc32.hpp"
+#include "vines/bytes/wire.hpp"
 
 namespace vines::fixed {
 

@@ -25,8 +25,8 @@
 
 #include <Eigen/Core>
 
-#include "vines/data.hpp"
-#include "vines/model.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
 

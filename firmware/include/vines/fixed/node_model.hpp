@@ -12,12 +12,12 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_mode.hpp"
 #include "vines/fixed/frame.hpp"
 #include "vines/fixed/image.hpp"
 #include "vines/fixed/readout.hpp"
 #include "vines/fixed/tmd.hpp"
 #include "vines/fixed/vines_step.hpp"
+#include "vines/model/contact_mode.hpp"
 #include "vines/numeric/fixed_math.hpp"
 
 namespace vines::fixed {

@@ -21,10 +21,10 @@
 #include <Eigen/Core>
 
 #include "vines/fixed/frame.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #if VINES_MODEL_REPORT
-#include "vines/sim.hpp"
+#include "vines/step/sim.hpp"
 #endif
 
 namespace vines::fixed {

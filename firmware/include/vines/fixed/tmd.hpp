@@ -58,7 +58,7 @@
 #endif
 
 #include "vines/fixed/frame.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
 #include "vines/numeric/fixed_math.hpp"
 

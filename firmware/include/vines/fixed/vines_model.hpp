@@ -27,11 +27,11 @@
 #include <Eigen/Core>
 
 #include "vines/fixed/contact_coupling.hpp"
-#include "vines/fixed/force_moments.hpp"
 #include "vines/fixed/frame.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/fixed_gain.hpp"
-#include "vines/substep_split.hpp"
+#include "vines/split/force_moments.hpp"
+#include "vines/step/substep_split.hpp"
 
 namespace vines::fixed {
 
@@ -76,7 +76,7 @@ struct FixedVines {
   VecP dk, dc;
   GainP dg0, dg1;
   // g(t)'s Taylor coefficients in powers of t / h, in the contact's units
-  // (fixed/forced_contact.hpp): G_k = -(ground term) - sum_j gd[k]_j
+  // (split/forced_contact.hpp): G_k = -(ground term) - sum_j gd[k]_j
   // D_{k+2,j}; ground terms a0 ga (k = 0), (a1 - a0) ga (k = 1). Shrunk n
   // times, every one scales by 2^6n.
   GainP gd[4];
@@ -92,7 +92,7 @@ struct FixedVines {
   // Into the contact: a position in L to an overlap in D, a speed in Vp to V,
   // and a slope of the start's cubic (L per step) to V.
   G to_overlap, to_speed, slope_to_speed;
-  // The Runge-Kutta step's rule (fixed/contact_step.hpp) in the contact's units.
+  // The Runge-Kutta step's rule (split/contact_step.hpp) in the contact's units.
   Q m_star_c, q_floor, dw_unit, dw_max;
   int max_steps = 0;
   Q count_depth;                   // overlap [D] a contact must pass to count
@@ -165,7 +165,7 @@ FixedVines<F, N, Law::template Kernel, K> build_fixed_vines(const Model<double, 
   o.to_overlap = G(L / u.d);
   o.to_speed = G(Vp / u.v);
   o.slope_to_speed = G(L / (h * u.v));
-  // The step rule: fixed/contact_step.hpp in the contact's units (the law's
+  // The step rule: split/contact_step.hpp in the contact's units (the law's
   // elastic coefficient is 5/4 there).
   const double c_hat = static_cast<double>(scaled_kernel<double>(dm.law, u).c);
   const double inv_m_star_hat = c_si.inv_m_star * u.m;

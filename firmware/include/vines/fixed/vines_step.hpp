@@ -8,7 +8,7 @@
 //      on its cubic (in units of L over a step of length 1);
 //   3. the free relative acceleration toward the wall as a Taylor cubic
 //      from the modes' derivatives (each in its mode's own unit), and the
-//      overlap's equation (fixed/forced_contact.hpp) in the contact's units;
+//      overlap's equation (split/forced_contact.hpp) in the contact's units;
 //   4. the step's end: the modes and the particle moved by the force's
 //      moments; a contact still on takes q back from the overlap;
 //   5. E_e and the top floor's peak (fixed_frame_close, fixed/frame.hpp).
@@ -20,12 +20,12 @@
 
 #include <Eigen/Core>
 
-#include "vines/fixed/contact_step.hpp"
-#include "vines/fixed/forced_contact.hpp"
 #include "vines/fixed/ledger.hpp"
 #include "vines/fixed/vines_model.hpp"
 #include "vines/numeric/fixed_math.hpp"
 #include "vines/numeric/hermite.hpp"
+#include "vines/split/contact_step.hpp"
+#include "vines/split/forced_contact.hpp"
 
 namespace vines::fixed {
 

@@ -12,7 +12,7 @@
 
 #include <Eigen/Core>
 
-#include "vines/link/crc32.hpp"
+#include "vines/bytes/crc32.hpp"
 
 namespace vines::image {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "vines/image/codec.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 
 namespace vines::image {
 

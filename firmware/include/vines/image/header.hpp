@@ -7,10 +7,10 @@
 #include <cstring>
 #include <type_traits>
 
+#include "vines/bytes/crc32.hpp"
 #include "vines/image/codec.hpp"
 #include "vines/image/fields.hpp"
-#include "vines/link/crc32.hpp"
-#include "vines/model.hpp"
+#include "vines/model/model.hpp"
 
 namespace vines::image {
 

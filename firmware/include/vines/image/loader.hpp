@@ -7,12 +7,12 @@
 #include <cstdint>
 #include <cstring>
 
-#include "vines/contact_laws.hpp"
+#include "vines/bytes/crc32.hpp"
 #include "vines/image/codec.hpp"
 #include "vines/image/fields.hpp"
 #include "vines/image/header.hpp"
-#include "vines/link/crc32.hpp"
-#include "vines/model.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/model.hpp"
 
 namespace vines::image {
 

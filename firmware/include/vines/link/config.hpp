@@ -9,9 +9,9 @@
 #include <cstdint>
 #include <initializer_list>
 
-#include "vines/contact_laws.hpp"
-#include "vines/link/wire.hpp"
-#include "vines/params.hpp"
+#include "vines/bytes/wire.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::link {
 

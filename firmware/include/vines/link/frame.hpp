@@ -9,9 +9,9 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "vines/bytes/crc32.hpp"
+#include "vines/bytes/wire.hpp"
 #include "vines/link/cobs.hpp"
-#include "vines/link/crc32.hpp"
-#include "vines/link/wire.hpp"
 
 namespace vines::link {
 

@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <utility>
 
-#include "vines/link/wire.hpp"
-#include "vines/params.hpp"
+#include "vines/bytes/wire.hpp"
+#include "vines/model/params.hpp"
 #include "vines/twin/image.hpp"
 
 namespace vines::link {

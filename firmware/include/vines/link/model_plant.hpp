@@ -13,13 +13,13 @@
 #include <cstdint>
 #include <cstring>
 
+#include "vines/image/model_image.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/hybrid_frame.hpp"
 #include "vines/link/messages.hpp"
 #include "vines/link/status_text.hpp"
-#include "vines/model_image.hpp"
+#include "vines/step/sim.hpp"
 #include "vines/twin/image.hpp"
-#include "vines/sim.hpp"
 
 namespace vines::link {
 

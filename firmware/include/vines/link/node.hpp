@@ -36,7 +36,7 @@
 #include "vines/link/messages.hpp"
 #include "vines/link/mode_outputs.hpp"
 #include "vines/link/status_text.hpp"
-#include "vines/validate.hpp"
+#include "vines/model/validate.hpp"
 
 namespace vines::link {
 

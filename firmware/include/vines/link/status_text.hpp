@@ -4,7 +4,7 @@
 
 #include <cstddef>
 
-#include "vines/param_error.hpp"
+#include "vines/model/param_error.hpp"
 
 namespace vines::link {
 

@@ -1,6 +1,6 @@
 // Classic Runge-Kutta step of y' = f(y) (autonomous: time, where it
 // matters, is a state), for the fixed-point contact integrations
-// (fixed/bounce.hpp, fixed/forced_contact.hpp). Each rate is multiplied by
+// (fixed/bounce.hpp, split/forced_contact.hpp). Each rate is multiplied by
 // its weight before any sum: in Q3.28 two rates of 5 would overflow the
 // range of 8 where their weighted increments are far below it.
 #pragma once

@@ -24,8 +24,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "vines/link/wire.hpp"
-#include "vines/params.hpp"
+#include "vines/bytes/wire.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines::twin {
 

@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-#include "vines/lti.hpp"
+#include "vines/model/lti.hpp"
 
 namespace vines::fixed {
 

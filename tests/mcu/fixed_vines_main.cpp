@@ -14,11 +14,11 @@
 
 #include "semihost.h"
 #include "two_tone.hpp"
-#include "vines/build_model.hpp"
+#include "vines/build/build_model.hpp"
 #include "vines/fixed/vines_step.hpp"
-#include "vines/frame_presets.hpp"
 #include "vines/hal/port.hpp"
-#include "vines/sim.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/step/sim.hpp"
 
 namespace {
 

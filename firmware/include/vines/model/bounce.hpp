@@ -9,10 +9,10 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact.hpp"
+#include "vines/model/contact.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
-#include "vines/step_control.hpp"
+#include "vines/numeric/step_control.hpp"
 
 namespace vines {
 

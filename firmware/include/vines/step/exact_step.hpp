@@ -11,12 +11,12 @@
 
 #include <cmath>
 
-#include "vines/data.hpp"
-#include "vines/model.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/peaks.hpp"
-#include "vines/substep.hpp"
+#include "vines/step/peaks.hpp"
+#include "vines/step/substep.hpp"
 
 namespace vines {
 

@@ -6,7 +6,7 @@
 //      exact flight;
 //   2. the contact: the one going on, or a start found on the cubic through
 //      both ends of the free relative motion;
-//   3. the overlap's equation (fixed/forced_contact.hpp) from there to the
+//   3. the overlap's equation (split/forced_contact.hpp) from there to the
 //      contact's end or the step's end, in w (dt/dw = 4 q^3) by classic
 //      Runge-Kutta: the free relative acceleration toward the wall a Taylor
 //      cubic from the step's start, the device floor's response to the
@@ -14,7 +14,7 @@
 //      about the step's end, mu_k = int F(s) (h - s)^k / k! ds, and the
 //      energy lost;
 //   4. the step's end: the frame is the free step plus sum_k (A^k bf) mu_k
-//      (fixed/force_moments.hpp), the particle its free flight less mu_1 / m
+//      (split/force_moments.hpp), the particle its free flight less mu_1 / m
 //      and mu_0 / m; a contact still on at the end takes q back from the
 //      assembled overlap (its rate from the assembled velocities), one that
 //      ended is counted; a contact that starts after another ended in the
@@ -36,22 +36,22 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_mode.hpp"
-#include "vines/data.hpp"
-#include "vines/events.hpp"
-#include "vines/exact_step.hpp"
-#include "vines/fixed/contact_step.hpp"
-#include "vines/fixed/force_moments.hpp"
-#include "vines/fixed/forced_contact.hpp"
-#include "vines/model.hpp"
+#include "vines/model/contact_mode.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/hermite.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/peaks.hpp"
-#include "vines/substep_common.hpp"
+#include "vines/split/contact_step.hpp"
+#include "vines/split/force_moments.hpp"
+#include "vines/split/forced_contact.hpp"
+#include "vines/step/events.hpp"
+#include "vines/step/exact_step.hpp"
+#include "vines/step/peaks.hpp"
+#include "vines/step/substep_common.hpp"
 
 namespace vines {
 
-// The force's moments a split step carries (fixed/force_moments.hpp).
+// The force's moments a split step carries (split/force_moments.hpp).
 #ifndef VINES_SPLIT_MOMENTS
 #define VINES_SPLIT_MOMENTS 6
 #endif
@@ -94,7 +94,7 @@ fixed::ContactCoupling<S, K> split_coupling(const Model<S, N, Dev>& m,
 
 // The Runge-Kutta step in w for a contact at q with overlap rate u under a
 // free relative acceleration toward the wall of at most g
-// (fixed/contact_step.hpp): about 2 loop.split_steps steps an impact,
+// (split/contact_step.hpp): about 2 loop.split_steps steps an impact,
 // whatever its speed. A contact with neither energy nor pressing gets the
 // scale of a thousandth of the model's typical one.
 template <typename S, int N, typename Dev>

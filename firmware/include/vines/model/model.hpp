@@ -11,12 +11,12 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_laws.hpp"
-#include "vines/devices.hpp"
-#include "vines/frame.hpp"
-#include "vines/lti.hpp"
-#include "vines/params.hpp"
-#include "vines/validate.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/devices.hpp"
+#include "vines/model/frame.hpp"
+#include "vines/model/lti.hpp"
+#include "vines/model/params.hpp"
+#include "vines/model/validate.hpp"
 
 namespace vines {
 

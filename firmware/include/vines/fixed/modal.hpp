@@ -22,7 +22,7 @@
 
 #include <cmath>
 
-#include "vines/lti.hpp"
+#include "vines/model/lti.hpp"
 #include "vines/numeric/fixed.hpp"
 
 namespace vines::numeric {

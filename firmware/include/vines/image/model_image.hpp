@@ -21,7 +21,7 @@
 //   20   4   layout check: CRC-32 of the body's field list (each field's wire
 //            type and entry count), so a host and a node built from sources
 //            whose field lists differ refuse each other's images
-//   24   4   CRC-32 (link/crc32.hpp) of the whole image but these 4 bytes
+//   24   4   CRC-32 (bytes/crc32.hpp) of the whole image but these 4 bytes
 // Body: the fields of visit_fields() (image/fields.hpp), in its order, each
 // as its raw little-endian entries (double: IEEE-754 binary64 bits, float: binary32;
 // bool: one byte 0/1; integers and enums: two's complement of their size);

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "vines/data.hpp"
-#include "vines/model.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/hermite.hpp"
 #include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"

@@ -1,5 +1,5 @@
 // Fixed-point image for an FPU-less core (Cortex-M3, MPS2-AN385, soft-float
-// ABI): the bare frame's modal exact step in Q3.28 (vines/numeric/fixed_modal.hpp)
+// ABI): the bare frame's modal exact step in Q3.28 (vines/fixed/modal.hpp)
 // against the same step in double (software floating point here), 20 s of a
 // two-tone ground motion at 1 kHz. Checks the top-floor error and that
 // nothing saturated; prints the instructions per step of both (timer 1 at
@@ -9,10 +9,10 @@
 
 #include "semihost.h"
 #include "two_tone.hpp"
-#include "vines/frame_presets.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/fixed/modal.hpp"
 #include "vines/hal/port.hpp"
-#include "vines/build_model.hpp"
-#include "vines/numeric/fixed_modal.hpp"
+#include "vines/model/frame_presets.hpp"
 
 namespace {
 

@@ -6,9 +6,9 @@
 
 #include <cmath>
 
-#include "vines/contact.hpp"
-#include "vines/contact_laws.hpp"
-#include "vines/params.hpp"
+#include "vines/model/contact.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines {
 

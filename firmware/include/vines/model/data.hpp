@@ -6,8 +6,8 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_mode.hpp"
-#include "vines/model.hpp"
+#include "vines/model/contact_mode.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/compensated.hpp"
 
 namespace vines {

@@ -23,15 +23,15 @@
 #include <cmath>
 #include <cstddef>
 
-#include "vines/data.hpp"
-#include "vines/exact_step.hpp"
-#include "vines/model.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/peaks.hpp"
-#include "vines/substep.hpp"
-#include "vines/substep_bounded.hpp"
-#include "vines/substep_split.hpp"
+#include "vines/step/exact_step.hpp"
+#include "vines/step/peaks.hpp"
+#include "vines/step/substep.hpp"
+#include "vines/step/substep_bounded.hpp"
+#include "vines/step/substep_split.hpp"
 
 namespace vines {
 

@@ -1,5 +1,5 @@
 // The split contact step's Runge-Kutta step in w (substep_split.hpp,
-// fixed/forced_contact.hpp), in any consistent units and any scalar: for a
+// split/forced_contact.hpp), in any consistent units and any scalar: for a
 // contact at q with overlap rate u under a free relative acceleration toward
 // the wall of at most g. The contact's energy (1/2) m* u^2 + (2/5) c q^10
 // (its Hertz part, c the law's elastic coefficient) reaches

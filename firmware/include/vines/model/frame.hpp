@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines {
 

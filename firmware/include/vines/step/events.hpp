@@ -13,8 +13,8 @@
 #include <cmath>
 #include <limits>
 
-#include "vines/contact_mode.hpp"
-#include "vines/model.hpp"
+#include "vines/model/contact_mode.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
 #include "vines/numeric/inline.hpp"

@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include "semihost.h"
-#include "vines/build_model.hpp"
-#include "vines/frame_presets.hpp"
-#include "vines/sim.hpp"
+#include "vines/build/build_model.hpp"
+#include "vines/model/frame_presets.hpp"
+#include "vines/step/sim.hpp"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // The two 10-story frames of docs/model.md section 2 (Sadek et al. 1997 benchmark).
 #pragma once
 
-#include "vines/params.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines {
 

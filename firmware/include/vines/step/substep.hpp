@@ -20,16 +20,16 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact_mode.hpp"
-#include "vines/data.hpp"
-#include "vines/events.hpp"
-#include "vines/model.hpp"
+#include "vines/model/contact_mode.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/inline.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/peaks.hpp"
-#include "vines/step_control.hpp"
-#include "vines/substep_common.hpp"
+#include "vines/numeric/step_control.hpp"
+#include "vines/step/events.hpp"
+#include "vines/step/peaks.hpp"
+#include "vines/step/substep_common.hpp"
 
 namespace vines {
 

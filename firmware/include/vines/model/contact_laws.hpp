@@ -22,10 +22,10 @@
 
 #include <cmath>
 
-#include "vines/bounce.hpp"
-#include "vines/contact.hpp"
-#include "vines/param_error.hpp"
-#include "vines/params.hpp"
+#include "vines/model/bounce.hpp"
+#include "vines/model/contact.hpp"
+#include "vines/model/param_error.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines {
 

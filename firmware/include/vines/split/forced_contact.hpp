@@ -13,7 +13,7 @@
 // step, whatever the contact's own time unit). Integrated in w (dt/dw = 4 q^3, q = d^{1/4}) by classic
 // Runge-Kutta, with the energy lost and the force's moments about the
 // step's end, mu_k = int F(s) (h - s)^k / k! ds (k < K), which move the
-// frame (fixed/force_moments.hpp) and the particle, and from which the I_k
+// frame (split/force_moments.hpp) and the particle, and from which the I_k
 // follow (floor_response). Each moment's rate is a quadrature of the force,
 // not a chain of integrals of one another: Runge-Kutta's error is then that
 // of the contact's own path.
@@ -31,14 +31,14 @@
 
 #include <Eigen/Core>
 
-#include "vines/contact.hpp"
+#include "vines/model/contact.hpp"
 #include "vines/numeric/rk4.hpp"
 
 namespace vines::fixed {
 
 // K: the moments carried (the frame's response to the force is then exact
 // to the power K - 1 of the step in the positions, K in the velocities,
-// fixed/force_moments.hpp).
+// split/force_moments.hpp).
 // R: the type of r_scale (S; in fixed point a numeric::Gain, since T / tau
 // may pass the format's range).
 template <typename S, int K = 4, typename R = S>

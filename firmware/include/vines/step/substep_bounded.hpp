@@ -50,13 +50,13 @@
 
 #include <Eigen/Core>
 
-#include "vines/data.hpp"
-#include "vines/events.hpp"
-#include "vines/model.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
 #include "vines/numeric/dopri5.hpp"
 #include "vines/numeric/hermite.hpp"
 #include "vines/numeric/minmax.hpp"
-#include "vines/substep_common.hpp"
+#include "vines/step/events.hpp"
+#include "vines/step/substep_common.hpp"
 
 namespace vines {
 

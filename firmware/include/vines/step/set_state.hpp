@@ -7,11 +7,11 @@
 
 #include <cmath>
 
-#include "vines/data.hpp"
-#include "vines/exact_step.hpp"
-#include "vines/model.hpp"
-#include "vines/sim.hpp"
-#include "vines/substep_common.hpp"
+#include "vines/model/data.hpp"
+#include "vines/model/model.hpp"
+#include "vines/step/exact_step.hpp"
+#include "vines/step/sim.hpp"
+#include "vines/step/substep_common.hpp"
 
 namespace vines {
 

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "vines/contact_laws.hpp"
-#include "vines/param_error.hpp"
-#include "vines/params.hpp"
+#include "vines/model/contact_laws.hpp"
+#include "vines/model/param_error.hpp"
+#include "vines/model/params.hpp"
 
 namespace vines {
 
