@@ -16,6 +16,7 @@
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/scene/names.hpp"
 #include "sim_host/scene/scene.hpp"
+#include "engine_support.hpp"
 #include "support.hpp"
 
 namespace {
@@ -23,11 +24,10 @@ namespace {
 using namespace vines;
 using namespace vines::host;
 
-const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
-
-std::unique_ptr<Engine> built(const SceneParams& p, Scalar scalar) { return build_engine(p, scalar, "test"); }
-
-bool has(const std::string& msg, const char* part) { return msg.find(part) != std::string::npos; }
+using test::built;
+using test::has;
+using test::kScenes;
+using test::samples;
 
 // Every figure of the totals and the snapshot, equal (bit for bit but for
 // the sign of zero).
@@ -57,13 +57,6 @@ void expect_same(const RunTotals& a, const RunTotals& b, const Snapshot& s, cons
   EXPECT_EQ(a.count.substeps, b.count.substeps) << what;
   EXPECT_EQ(a.count.bad_samples, b.count.bad_samples) << what;
   EXPECT_EQ(a.fixed_saturations, b.fixed_saturations) << what;
-}
-
-// 8 s of El Centro at 1 kHz: the strong part, with contacts.
-std::vector<double> samples() {
-  std::vector<double> a = test::elcentro(1000.0);
-  a.resize(8001);
-  return a;
 }
 
 // Half a record, saved; the rest on the engine and, from the state, on a

@@ -17,6 +17,7 @@
 #include "sim_host/engines/build_engine.hpp"
 #include "sim_host/scene/names.hpp"
 #include "sim_host/scene/scene.hpp"
+#include "engine_support.hpp"
 #include "support.hpp"
 
 namespace {
@@ -24,18 +25,10 @@ namespace {
 using namespace vines;
 using namespace vines::host;
 
-const std::string kScenes = std::string(VINES_SOURCE_DIR) + "/data/scenes/";
-
-std::unique_ptr<Engine> built(const SceneParams& p, Scalar scalar) { return build_engine(p, scalar, "test"); }
-
-bool has(const std::string& msg, const char* part) { return msg.find(part) != std::string::npos; }
-
-// 8 s of El Centro at 1 kHz: the strong part, with contacts.
-std::vector<double> samples() {
-  std::vector<double> a = test::elcentro(1000.0);
-  a.resize(8001);
-  return a;
-}
+using test::built;
+using test::has;
+using test::kScenes;
+using test::samples;
 
 // The physical state a snapshot reads, set.
 PhysicalState physical(const Snapshot& s, int stories, DeviceKind kind) {
