@@ -104,9 +104,8 @@ struct PageServer::Impl {
   std::map<MHD_Connection*, Pending> pending;
   // The event streams waiting for the hub, out of the server's loop (its
   // one thread never waits): the waker resumes them when the hub changes,
-  // and each second (a stream's keep-alive). None suspends once closing.
+  // and each second (a stream's keep-alive). None suspends once stopping.
   std::vector<MHD_Connection*> suspended;
-  bool closing = false;
   bool stopping = false;
   std::thread watchdog, waker;
 
@@ -175,7 +174,7 @@ ssize_t read_stream(void* cls, std::uint64_t, char* buf, std::size_t max) {
         // A comment now and then, so that a client still reading is told
         // apart from one that stopped (whose socket fills).
         if (Clock::now() - s->last < kKeepAlive) {
-          if (s->impl->closing) return MHD_CONTENT_READER_END_WITH_ERROR;
+          if (s->impl->stopping) return MHD_CONTENT_READER_END_WITH_ERROR;
           s->impl->suspended.push_back(s->connection);
           MHD_suspend_connection(s->connection);
           return 0;
@@ -386,7 +385,7 @@ std::string PageServer::url() const { return "http://" + authority() + "/"; }
 
 // The daemon's stop closes every connection, a client's half-sent request
 // or unread stream included: it never waits on a client. No stream may be
-// suspended then (MHD aborts): none suspends once closing, the waker
+// suspended then (MHD aborts): none suspends once stopping, the waker
 // resumes the last ones and ends.
 void PageServer::stop(std::chrono::milliseconds linger, bool hold) {
   if (!impl_->daemon) return;
@@ -394,7 +393,7 @@ void PageServer::stop(std::chrono::milliseconds linger, bool hold) {
   else impl_->hub.wait_until_no_clients(linger);
   {
     std::lock_guard<std::mutex> lock(impl_->m);
-    impl_->closing = impl_->stopping = true;
+    impl_->stopping = true;
   }
   impl_->cv.notify_all();
   impl_->waker.join();
