@@ -9,21 +9,12 @@
 #include <memory>
 #include <string>
 
+#include "sim_host/monitor/http_parse.hpp"
 #include "sim_host/monitor/hub.hpp"
 
 struct MHD_Connection;
 
 namespace vines::host::monitor {
-
-// Where to listen: --serve [HOST:]PORT or [IPV6]:PORT (HOST 127.0.0.1 unless
-// given).
-struct Address {
-  std::string host = "127.0.0.1";
-  int port = 0;  // 0: any free port
-};
-// Parses [HOST:]PORT or [IPV6]:PORT; throws std::invalid_argument naming
-// OPTION and VALUE (an IPv6 address without brackets too).
-Address parse_address(const std::string& option, const std::string& value);
 
 class PageServer {
  public:
