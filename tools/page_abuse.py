@@ -19,7 +19,7 @@ import sys
 import threading
 import time
 
-TIMING = {"wall_time_s", "latency_us", "deadline_misses", "node_deadline", "step_ticks"}
+TIMING = {"wall_time_s", "latency_us", "deadline_misses", "node_deadline", "step_ticks", "steps_over_budget"}
 
 
 def connect(port):
