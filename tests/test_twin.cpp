@@ -5,6 +5,7 @@
 // same image; bad inputs refused with the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -152,15 +153,60 @@ TEST(Twin, VinesBuildingLossAndImpacts) {
   EXPECT_NEAR(static_cast<double>(t.device.impacts_estimated), static_cast<double>(t.device.contacts_truth),
               0.3 * static_cast<double>(t.device.contacts_truth));
   EXPECT_LT(std::fabs(t.device.added_mass_ratio), 0.3);
+  // The impulse over the impacts alone: the estimate's noise between them
+  // (about 5 kN) would add up to a third here.
+  EXPECT_NEAR(t.device.impulse_estimated_ns, t.device.impulse_truth_ns, 0.1 * t.device.impulse_truth_ns);
+}
+
+// The range of the floor's absolute displacement in the truth: the ground's,
+// integrated from the samples sent, plus the floor's own.
+double truth_floor_travel(const Scene& sc, const HilOptions& o) {
+  const Excitation ex = load_excitation(sc, "");
+  const TwinBench tb = make_twin_bench(sc, o, ex);
+  const double h = 1.0 / ex.rate_hz;
+  double v = 0, u = 0, lo = 0, hi = 0;
+  for (std::size_t k = 0; k < tb.truth.roof_x.size() && k < ex.samples.size(); ++k) {
+    lo = std::min(lo, u + tb.truth.roof_x[k]), hi = std::max(hi, u + tb.truth.roof_x[k]);
+    u += (v + 0.5 * ex.samples[k] * h) * h, v += ex.samples[k] * h;
+  }
+  return hi - lo;
 }
 
 // A jammed sphere moves with its floor: the floor's identified mass gains
-// most of the sphere's, and the sphere is reported stuck.
+// most of the sphere's, no impact is seen where the floor travelled far
+// past the sphere's free travel (a free sphere at rest would have hit), and
+// the sphere is reported stuck.
 TEST(Twin, StuckSphereReported) {
-  const HilTwinReport t = run_twin("elcentro_vines.toml", twin(0, "twin/truth_sphere_stuck.toml"));
+  const HilOptions o = twin(0, "twin/truth_sphere_stuck.toml");
+  const HilTwinReport t = run_twin("elcentro_vines.toml", o);
   EXPECT_EQ(t.device.sphere, "stuck");
   EXPECT_GT(t.device.added_mass_ratio, 0.5);
   EXPECT_EQ(t.device.contacts_truth, 0);
+  EXPECT_EQ(t.device.impacts_estimated, 0);
+  EXPECT_NEAR(t.device.free_travel_m, 2 * 0.4148, 1e-4);  // the scene's box (docs/model.md)
+  const double travel = truth_floor_travel(load_scene(scene_path("elcentro_vines.toml")), o);
+  EXPECT_NEAR(t.device.floor_travel_m, travel, 0.02 * travel);
+  EXPECT_GT(t.device.floor_travel_m, 1.25 * t.device.free_travel_m);
+}
+
+// Weak shaking (El Centro at 0.05 g) never brings the sphere, at rest in the
+// middle of its box, to a wall: no impact is seen in the estimate's noise,
+// the floor travelled less than the sphere's free travel, and the sphere is
+// still (not moving, not stuck).
+TEST(Twin, SphereThatNeverHitIsStill) {
+  Scene sc = load_scene(scene_path("elcentro_vines.toml"));
+  sc.params.device.vines.start_at_left_wall = false;
+  sc.params.device.vines.initial_position_m = 0;
+  sc.target_pga_mps2 = 0.05 * 9.80665;
+  sc.duration_s = 30;
+  const HilReport r = run_hil(sc, twin(30));
+  ASSERT_TRUE(r.twin);
+  const HilTwinDevice& d = r.twin->device;
+  EXPECT_EQ(d.contacts_truth, 0);
+  EXPECT_EQ(d.impacts_estimated, 0);
+  EXPECT_LT(d.floor_travel_m, d.free_travel_m);
+  EXPECT_EQ(d.sphere, "still");
+  EXPECT_EQ(d.impulse_estimated_ns, 0.0);
 }
 
 // A TMD 10 % low in frequency: its spring identified, the TMD reported

@@ -51,9 +51,9 @@ void print_twin(const host::HilTwinReport& t) {
   const host::HilTwinDevice& d = t.device;
   if (d.kind == "vines")
     std::printf("    VI NES: sphere %s; impulse |F| dt %.4g N s (truth %.4g), %lld impacts seen (truth %lld contacts), "
-                "added mass %.2f x the sphere's\n",
+                "added mass %.2f x the sphere's, floor travel %.3g m (the sphere's free travel %.3g m)\n",
                 d.sphere.c_str(), d.impulse_estimated_ns, d.impulse_truth_ns, d.impacts_estimated, d.contacts_truth,
-                d.added_mass_ratio);
+                d.added_mass_ratio, d.floor_travel_m, d.free_travel_m);
   if (d.kind == "tmd")
     std::printf("    TMD: frequency %.3f (sd %.3f) x its design (truth %.3f)%s\n", d.frequency_factor,
                 d.frequency_factor_sd, d.truth_frequency_factor, d.detuned ? ": DETUNED" : "");

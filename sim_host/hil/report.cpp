@@ -33,6 +33,8 @@ json to_json(const HilTwinDevice& d) {
               {"impacts_estimated", d.impacts_estimated},
               {"contacts_truth", d.contacts_truth},
               {"added_mass_ratio", d.added_mass_ratio},
+              {"floor_travel_m", d.floor_travel_m},
+              {"free_travel_m", d.free_travel_m},
               {"sphere", d.sphere}});
   if (d.kind == "tmd")
     j.update({{"frequency_factor", d.frequency_factor},

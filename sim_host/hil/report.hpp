@@ -68,7 +68,13 @@ struct HilTwinDevice {
   double impulse_estimated_ns = 0, impulse_truth_ns = 0;
   long long impacts_estimated = 0, contacts_truth = 0;
   double added_mass_ratio = 0;   // the mass the device's floor gained (estimated), over the sphere's
-  std::string sphere;            // "moving", "stuck" (moves with its floor) or "still" (no impact seen)
+  // The device floor's absolute travel over the run (estimated: the ground's
+  // displacement plus the floor's), and the sphere's free travel in its box.
+  double floor_travel_m = 0, free_travel_m = 0;
+  // "moving"; "stuck" (moves with its floor: its mass gained by the floor, or
+  // no impact seen where the floor travelled a quarter beyond the sphere's
+  // free travel, so that a free sphere must have hit); "still" (no impact seen)
+  std::string sphere;
   // TMD
   double frequency_factor = 1, frequency_factor_sd = 0, truth_frequency_factor = 1;
   bool detuned = false;

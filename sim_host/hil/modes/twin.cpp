@@ -136,6 +136,7 @@ TwinBench make_twin_bench(const Scene& scene, const HilOptions& o, const Excitat
   const std::unique_ptr<Engine> nominal = build_engine(scene.params, Scalar::kDouble, scene.path);
   const ModelInfo ni = nominal->info();
   tr.particle_mass = ni.vines.mass;  // the sphere the node's scene designs
+  tr.particle_gap = ni.vines.gap;
   if (ni.tmd.omega > 0 && truth.params.device.kind == DeviceKind::kTmd) tr.tmd_frequency_factor = ti.tmd.omega / ni.tmd.omega;
   if (o.estimator == HilEstimator::kKalman) {
     TwinBaselineStats base;

@@ -28,6 +28,7 @@ struct TwinTruth {
   std::vector<double> device_force; // VI NES: the device's force on its floor [N]; TMD, none: 0
   double tmd_frequency_factor = 1;  // truth TMD frequency / the node's design
   double particle_mass = 0;         // the node's VI NES sphere [kg] (its design)
+  double particle_gap = 0;          // ...its free travel each side of the box's centre [m]
   long long contacts = 0;
 };
 

@@ -217,30 +217,57 @@ class TwinMode : public BenchMode {
     }
     if (dp.kind != DeviceKind::kVines) return;
     d->kind = "vines";
-    // Impulses: |F| integrated, the node's estimate and the truth's; impacts:
-    // excursions of |F| beyond 6 robust sd of the estimate, 20 ms apart; the
-    // mass the device floor gained, over the sphere's: a stuck sphere moves
-    // with its floor.
+    // Impacts: excursions of |F| beyond 50 robust sd of the estimate, 20 ms
+    // apart (an impact's peak is some 5,000; without one, the estimate's
+    // largest excursions reached 29 in the campaign, and 6 counted noise as
+    // impacts in most runs with none). The impulse: |F| integrated over them
+    // and two samples on either side (over the whole run, the estimate's
+    // noise, some 5 kN on the El Centro VI NES, made it up to 1.8 times the
+    // truth's); the truth's: |F| over the whole run. The mass the device floor gained, over
+    // the sphere's: a stuck sphere moves with its floor.
     const double h = b_.h;
     std::vector<double> F;
     for (long long k = 0; k < rec.samples; ++k) {
       const auto i = static_cast<std::size_t>(k);
       d->impulse_truth_ns += std::fabs(tb_.truth.device_force[i]) * h;
-      if (!rec.got[i]) continue;
-      F.push_back(rec.tel[i].contact_force);
-      d->impulse_estimated_ns += std::fabs(F.back()) * h;
+      if (rec.got[i]) F.push_back(rec.tel[i].contact_force);
     }
-    const double thr = 6 * robust_sd(F);
+    const double thr = 50 * robust_sd(F);
     const auto dead = static_cast<long long>(std::ceil(0.02 / h));
     long long last = -dead - 1;
-    for (std::size_t i = 0; i < F.size(); ++i)
-      if (std::fabs(F[i]) > thr && static_cast<long long>(i) - last > dead) ++d->impacts_estimated, last = static_cast<long long>(i);
-      else if (std::fabs(F[i]) > thr) last = static_cast<long long>(i);
+    auto near = [&](std::size_t i) {
+      for (std::size_t j = i > 2 ? i - 2 : 0; j <= i + 2 && j < F.size(); ++j)
+        if (std::fabs(F[j]) > thr) return true;
+      return false;
+    };
+    for (std::size_t i = 0; i < F.size(); ++i) {
+      if (near(i)) d->impulse_estimated_ns += std::fabs(F[i]) * h;
+      if (std::fabs(F[i]) <= thr) continue;
+      if (static_cast<long long>(i) - last > dead) ++d->impacts_estimated;
+      last = static_cast<long long>(i);
+    }
     d->contacts_truth = tb_.truth.contacts;
     const int floor = (dp.floor > 0 ? dp.floor : n) - 1;
     const double md = b_.scene.params.frame.mass_kg[floor], mp = tb_.truth.particle_mass;
     d->added_mass_ratio = mp > 0 ? (f.eta[static_cast<std::size_t>(n)] - 1.0) * md / mp : 0.0;
-    d->sphere = d->added_mass_ratio > 0.5 ? "stuck" : d->impacts_estimated == 0 ? "still" : "moving";
+    // Between impacts the sphere keeps its velocity: with none from rest at
+    // t = 0, it never moved, and the box's walls travelled past it by the
+    // floor's absolute travel (the ground's displacement, from the samples
+    // sent, plus the floor's estimate).
+    double v = 0, u = 0, lo = 0, hi = 0;
+    for (long long k = 0; k < rec.samples; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (!rec.got[i]) continue;
+      const double D = u + rec.tel[i].x[static_cast<std::size_t>(floor)];
+      lo = std::min(lo, D), hi = std::max(hi, D);
+      const double a = rec.tel[i].ag;
+      u += (v + 0.5 * a * h) * h, v += a * h;
+    }
+    d->floor_travel_m = hi - lo, d->free_travel_m = 2 * tb_.truth.particle_gap;
+    const bool must_hit = d->floor_travel_m > 1.25 * d->free_travel_m;
+    d->sphere = d->added_mass_ratio > 0.5 || (d->impacts_estimated == 0 && must_hit) ? "stuck"
+                : d->impacts_estimated == 0                                            ? "still"
+                                                                                       : "moving";
   }
 
   const Bench& b_;
