@@ -21,11 +21,12 @@ lap "release built"
 ctest --preset release
 lap "release tested"
 
-# The host under AddressSanitizer and UBSan (preset debug): the subset labelled
+# The host under AddressSanitizer and UBSan (preset sanitize: the debug
+# preset's flags, with only the engines the subset runs): the subset labelled
 # unit_sanitize (tests/README.md: which tests, why a subset, its time); any
 # sanitizer report stops the test and fails it (halt_on_error in the preset).
-cmake --preset debug
-cmake --build --preset debug -j2 --target sanitize_tests
+cmake --preset sanitize
+cmake --build --preset sanitize -j2 --target sanitize_tests
 ctest --preset sanitize
 lap "sanitizer subset tested"
 
