@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """tools/figures.py and tools/plot_bench.py on small `vines bench --csv` files:
-the table's rows and stamp, and the refusals (exit 2 naming the file).
+the table's rows and stamp, and the refusals (exit 2 naming the file); the
+parts of tools/test.sh from a small log.
 
 Usage: figures_test.py REPO_ROOT
 """
@@ -62,6 +63,22 @@ with tempfile.TemporaryDirectory() as tmp:
             check(f"{name} {os.path.basename(path)}: exit 2 naming it ({says})",
                   r.returncode == 2 and f"{name}: {path}: " in r.stderr and says in r.stderr)
     check("nothing written on a refusal", not os.path.exists(os.path.join(tmp, "x.out")))
+
+    # The parts of tools/test.sh from its output: each part's time is the
+    # difference of its lap and the one before.
+    log = os.path.join(tmp, "test.log")
+    with open(log, "w") as f:
+        f.write("setup: ok\ntest.sh: packages ready at 2 s\n[ 50%] Building x\ntest.sh: release built at 700 s\n"
+                "test.sh: release tested at 1000 s\ntest.sh: all passed in 1000 s\n")
+    out = os.path.join(tmp, "figures", "test_times.md")
+    r = run(FIGURES, "test-times", log, "--out", out)
+    text = open(out).read() if os.path.exists(out) else ""
+    check("test times: one row a part, its time and when it ended",
+          r.returncode == 0 and "| packages ready | 2 | 2 |" in text and "| release built | 698 | 700 |" in text
+          and "| release tested | 300 | 1000 |" in text and "Whole run: 1000 s (16.7 min)." in text)
+    r = run(FIGURES, "test-times", good, "--out", os.path.join(tmp, "x.out"))
+    check("test times: a file without laps is refused, naming it",
+          r.returncode == 2 and f"figures.py: {good}: no 'test.sh: " in r.stderr and not os.path.exists(os.path.join(tmp, "x.out")))
 
 print(f"figures_test: {len(failures)} failed")
 sys.exit(1 if failures else 0)

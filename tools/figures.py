@@ -9,6 +9,7 @@ bench's deadlines with and without the monitoring page (tools/page_deadlines.sh)
 
   figures.py bench BENCH.csv [--out docs/figures/bench.md] [--command CMD]
   figures.py deadlines RUNS.jsonl [--out docs/figures/page_deadlines.md] [--command CMD]
+  figures.py test-times TEST.log [--out docs/figures/test_times.md] [--command CMD]
 
 Exit code 2, with a message naming the path, on a missing file or column.
 """
@@ -18,6 +19,7 @@ import datetime
 import json
 import os
 import platform
+import re
 import subprocess
 import sys
 
@@ -171,6 +173,25 @@ def deadlines_body(path):
                   "latency mean / p99 / max (us)", "samples on the page"], rows)
 
 
+# ---- the parts of tools/test.sh and their times ----
+
+def test_times_body(path):
+    """The table of tools/test.sh's laps ("test.sh: PART at N s" lines)."""
+    try:
+        with open(path, errors="replace") as f:
+            laps = [(m.group(1), int(m.group(2))) for m in (re.match(r"test\.sh: (.+) at (\d+) s$", line.rstrip())
+                                                             for line in f) if m]
+    except OSError as e:
+        fail("figures.py", f"{path}: {e.strerror}")
+    if not laps:
+        fail("figures.py", f"{path}: no 'test.sh: ... at N s' lines (the output of bash tools/test.sh)")
+    rows, before = [], 0
+    for part, at in laps:
+        rows.append([part, at - before, at])
+        before = at
+    return table(["part", "took s", "at s"], rows) + ["", f"Whole run: {laps[-1][1]} s ({laps[-1][1] / 60:.1f} min)."]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
@@ -183,7 +204,19 @@ def main():
     d.add_argument("jsonl")
     d.add_argument("--out", default=os.path.join(FIGURES, "page_deadlines.md"))
     d.add_argument("--command", default="bash tools/page_deadlines.sh")
+    t = sub.add_parser("test-times", help="the parts of tools/test.sh and their times, from its output")
+    t.add_argument("log")
+    t.add_argument("--out", default=os.path.join(FIGURES, "test_times.md"))
+    t.add_argument("--command", default="bash tools/test.sh > test.log 2>&1; python3 tools/figures.py test-times test.log")
     a = ap.parse_args()
+    if a.what == "test-times":
+        write(a.out, "The parts of `tools/test.sh` and their times", a.command,
+              ["`tools/test.sh` on a clean clone (no build folder, no compiler cache): the release build and its",
+               "tests, the sanitizer subset (preset `sanitize`), then each board's images and their tests in",
+               "QEMU. CI allows 90 minutes for the whole, `tools/setup.sh` included.", ""]
+              + test_times_body(a.log))
+        print(f"figures.py: wrote {a.out}")
+        return
     if a.what == "deadlines":
         write(a.out, "The bench's deadlines with and without the monitoring page", a.command,
               ["`vines hil data/scenes/elcentro_vines.toml --realtime` (1 kHz, host node): without `--serve`,",
