@@ -27,7 +27,13 @@ std::uint64_t steady_ns() {
 
 }  // namespace
 
-void port_init() {}
+// A fresh link on stdin/stdout (`vines node --listen` puts each bench's
+// connection there in turn).
+void port_init() {
+  g_error = "";
+  g_in_len = g_in_pos = 0;
+  g_closed = false;
+}
 
 int link_getc(std::uint32_t timeout_ms) {
   if (g_in_pos < g_in_len) return g_in[g_in_pos++];

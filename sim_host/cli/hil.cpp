@@ -8,14 +8,16 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <utility>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/cli/hil_print.hpp"
 #include "sim_host/cli/serve.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/tcp.hpp"
 #include "sim_host/hil/modes/twin_baseline.hpp"
 #include "sim_host/scene/scene.hpp"
 
@@ -170,6 +172,13 @@ void add_hil(CLI::App& vines) {
            const std::vector<std::string> names = host::node_names();
            if (std::find(names.begin(), names.end(), v) != names.end()) {
              opt.node = v;
+           } else if (v.rfind("tcp:", 0) == 0) {
+             try {
+               host::parse_tcp_address(v, "", false);
+             } catch (const std::runtime_error& e) {
+               throw CLI::ValidationError("--node", e.what());
+             }
+             opt.node = v;
            } else if (v.rfind("qemu:", 0) == 0) {
              throw CLI::ValidationError("--node", v + ": not a node (" + host::node_list() + ", or a program's path)");
            } else {
@@ -177,7 +186,8 @@ void add_hil(CLI::App& vines) {
            }
          },
          host::node_list() + " (default host: `vines node`; qemu:TARGET: the board image in QEMU, in the "
-         "board's scalar, instructions counted; build the preset first), or the path of a node program")
+         "board's scalar, instructions counted; build the preset first), tcp:HOST:PORT (a node that `vines node "
+         "--listen` runs, here or on another machine), or the path of a node program")
       ->type_name("N");
   cmd->add_option("--image", opt.image,
                   "the board image to run (default: build/TARGET/firmware/app/vines_node_DEVICE.elf; in twin mode with "

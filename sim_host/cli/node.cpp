@@ -1,8 +1,12 @@
-// `vines node`: the firmware node on stdin/stdout (what `vines hil` runs).
+// `vines node`: the firmware node on stdin/stdout (what `vines hil` runs), or
+// on TCP for a bench elsewhere (--listen).
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/tcp.hpp"
 
 namespace vines::cli {
 
@@ -10,16 +14,31 @@ void add_node(CLI::App& vines) {
   struct NodeArgs {
     bool realtime = false;
     double idle_timeout_s = 30;
+    std::string listen;
   };
   auto a = std::make_shared<NodeArgs>();
   CLI::App* cmd =
       add_command(vines, "node",
                   "The firmware node on stdin/stdout (what `vines hil` runs; protocol in docs/link_protocol.md).", "",
-                  [a] { return host::node_main(a->realtime, a->idle_timeout_s); });
+                  [a] { return host::node_main(a->realtime, a->idle_timeout_s, a->listen); });
   cmd->add_flag("--realtime", a->realtime, "deadlines on the local clock (default: the samples' stamps)");
   cmd->add_option("--idle-timeout", a->idle_timeout_s, "give up after S seconds without a byte (default 30)")
       ->type_name("S")
       ->check(positive_up_to(4e6));
+  cmd->add_option_function<std::string>(
+         "--listen",
+         [a](const std::string& v) {
+           try {
+             host::parse_tcp_address(v, "127.0.0.1", true);
+           } catch (const std::runtime_error& e) {
+             throw CLI::ValidationError("--listen", e.what());
+           }
+           a->listen = v;
+         },
+         "wait for a bench on TCP instead (`vines hil ... --node tcp:HOST:PORT`): one at a time, each a fresh "
+         "node, until killed; HOST 127.0.0.1 unless given (0.0.0.0: every interface; the link has no "
+         "authentication, keep it on a lab network); PORT 0: a free one; prints where it listens")
+      ->type_name("tcp:[HOST:]PORT");
 }
 
 }  // namespace vines::cli

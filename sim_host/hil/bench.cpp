@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/link/tcp.hpp"
 #include "sim_host/hil/offline.hpp"
 #include "vines/link/ats.hpp"
 #include "vines/model/contact_laws.hpp"
@@ -85,6 +86,8 @@ void choose_node(Bench* b) {
     o.image = board_image(o, *b->board, b->scene);
     if (o.timeout_s <= 0) o.timeout_s = 60;  // QEMU boots, and takes ~20 kB/s
     b->scene.scalar = b->board->scalar;      // the board's scalar, whatever the scene says
+  } else if (o.node.rfind("tcp:", 0) == 0) {
+    parse_tcp_address(o.node, "", false);  // throws naming what is wrong
   } else if (o.node != "host") {
     throw std::runtime_error(refused);
   }

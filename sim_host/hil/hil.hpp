@@ -25,7 +25,10 @@ namespace vines::host {
 HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch = nullptr);
 
 // `vines node`: the host firmware node on stdin/stdout, deadlines on the local
-// clock with realtime; it gives up after idle_timeout_s without a byte.
-int node_main(bool realtime, double idle_timeout_s);
+// clock with realtime; it gives up after idle_timeout_s without a byte. With
+// listen ("tcp:[HOST:]PORT"), a node on TCP for one bench at a time, each
+// connection a fresh node, until killed (throws naming the address when it
+// cannot listen).
+int node_main(bool realtime, double idle_timeout_s, const std::string& listen = "");
 
 }  // namespace vines::host

@@ -1,25 +1,20 @@
 #include "sim_host/hil/link/child.hpp"
 
 #include <fcntl.h>
-#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <cmath>
 #include <chrono>
 #include <climits>
 #include <cstring>
 #include <stdexcept>
 #include <thread>
 
+#include "sim_host/hil/link/fd_io.hpp"
+
 namespace vines::host {
-namespace {
-
-int ms(double s) { return s <= 0 ? 0 : static_cast<int>(std::min(s * 1e3 + 0.999, 1e9)); }
-
-}  // namespace
 
 std::string self_exe() {
   char buf[PATH_MAX];
@@ -63,43 +58,10 @@ ChildProcess::~ChildProcess() {
 }
 
 void ChildProcess::write_all(const std::uint8_t* p, std::size_t n, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (n > 0) {
-    const ssize_t w = in_ >= 0 ? ::write(in_, p, n) : -1;
-    if (w > 0) {
-      p += w;
-      n -= static_cast<std::size_t>(w);
-      continue;
-    }
-    if (w < 0 && errno != EAGAIN && errno != EINTR)
-      throw std::runtime_error(std::string("node: cannot write to it: ") + std::strerror(errno));
-    const double left = std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
-    if (left <= 0) throw std::runtime_error("node: not reading its input (write timed out)");
-    pollfd pf{in_, POLLOUT, 0};
-    ::poll(&pf, 1, ms(left));
-  }
+  write_all_fd(in_, p, n, timeout_s);
 }
 
-bool ChildProcess::read_some(std::vector<std::uint8_t>* out, double timeout_s) {
-  if (out_ < 0) return false;
-  pollfd pf{out_, POLLIN, 0};
-  const double t = std::max(0.0, std::min(timeout_s, 1e6));
-  timespec ts{static_cast<time_t>(t), static_cast<long>((t - std::floor(t)) * 1e9)};
-  const int r = ::ppoll(&pf, 1, &ts, nullptr);
-  if (r <= 0) return true;
-  std::uint8_t buf[8192];
-  for (;;) {
-    const ssize_t n = ::read(out_, buf, sizeof buf);
-    if (n > 0) {
-      out->insert(out->end(), buf, buf + n);
-      continue;
-    }
-    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return true;
-    ::close(out_);
-    out_ = -1;
-    return false;
-  }
-}
+bool ChildProcess::read_some(std::vector<std::uint8_t>* out, double timeout_s) { return read_some_fd(&out_, out, timeout_s); }
 
 int ChildProcess::finish(double timeout_s) {
   if (status_ >= 0) return status_;

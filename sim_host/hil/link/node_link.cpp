@@ -4,6 +4,8 @@
 #include <stdexcept>
 
 #include "sim_host/hil/link/boards.hpp"
+#include "sim_host/hil/link/child.hpp"
+#include "sim_host/hil/link/tcp.hpp"
 
 namespace vines::host {
 
@@ -13,7 +15,13 @@ double seconds_since(HilClock::time_point t0) { return std::chrono::duration<dou
 
 NodeLink::NodeLink(const HilOptions& opt, long long life, std::vector<link::Fault>* faults,
                    std::vector<long long>* fault_life)
-    : opt_(opt), life_(life), faults_(faults), fault_life_(fault_life), name_(argv(opt)[0]), child_(argv(opt)) {}
+    : opt_(opt), life_(life), faults_(faults), fault_life_(fault_life),
+      name_(opt.node.rfind("tcp:", 0) == 0 ? opt.node : argv(opt)[0]), link_(open(opt)) {}
+
+std::unique_ptr<NodeTransport> NodeLink::open(const HilOptions& opt) {
+  if (opt.node.rfind("tcp:", 0) == 0) return std::make_unique<TcpNode>(parse_tcp_address(opt.node, "", false), opt.timeout_s);
+  return std::make_unique<ChildProcess>(argv(opt));
+}
 
 // A board image runs in QEMU; any other node is a program run as `PROGRAM node`.
 std::vector<std::string> NodeLink::argv(const HilOptions& opt) {
@@ -31,8 +39,9 @@ std::vector<std::uint8_t> NodeLink::encode_empty(link::MsgType type) {
 
 void NodeLink::send(const std::vector<std::uint8_t>& bytes) {
   try {
-    child_.write_all(bytes.data(), bytes.size(), opt_.timeout_s);
+    link_->write_all(bytes.data(), bytes.size(), opt_.timeout_s);
   } catch (const std::runtime_error& e) {
+    if (name_.rfind("tcp:", 0) == 0) throw std::runtime_error("node " + name_ + ": the connection ended (" + e.what() + ")");
     throw std::runtime_error(name_ + ": " + e.what());
   }
   delimiters_ += static_cast<std::uint32_t>(std::count(bytes.begin(), bytes.end(), 0));
@@ -41,13 +50,16 @@ void NodeLink::send(const std::vector<std::uint8_t>& bytes) {
 void NodeLink::pump(double timeout_s) {
   const bool open = read(timeout_s);
   // A node ends after answering STOP; before that, an exit is a failure.
-  if (!open && acked_ < delimiters_)
-    throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(child_.finish(1)) +
-                             ") with " + std::to_string(delimiters_ - acked_) + " frames unanswered");
+  if (!open && acked_ < delimiters_) {
+    const std::string unanswered = " with " + std::to_string(delimiters_ - acked_) + " frames unanswered";
+    if (name_.rfind("tcp:", 0) == 0) throw std::runtime_error("node " + name_ + ": the connection ended" + unanswered);
+    throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) + ")" +
+                             unanswered);
+  }
 }
 
 void NodeLink::kill() {
-  child_.kill_now();
+  link_->kill_now();
   // What it sent before it died is still in the pipe: read until the pipe
   // ends, or 0.1 s without a byte (a program that left the pipe open).
   for (std::size_t n = 1; n > 0;) {
@@ -58,11 +70,16 @@ void NodeLink::kill() {
 
 bool NodeLink::read(double timeout_s) {
   buf_.clear();
-  const bool open = child_.read_some(&buf_, timeout_s);
+  const bool open = link_->read_some(&buf_, timeout_s);
   const double now = seconds_since(t0_);
   for (std::uint8_t b : buf_) {
     const link::DecodeResult r = dec_.push(b);
     if (r == link::DecodeResult::kNone) continue;
+    if (r == link::DecodeResult::kBadVersion)  // a whole frame, its CRC good: another protocol
+      throw std::runtime_error("node " + name_ + " speaks link protocol version " +
+                               std::to_string(dec_.frame().version) + ", this bench version " +
+                               std::to_string(link::kProtocolVersion) + " (docs/link_protocol.md): build both from "
+                               "the same checkout");
     if (r != link::DecodeResult::kFrame) {
       ++bad_frames_;
       continue;

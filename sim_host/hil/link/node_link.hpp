@@ -6,10 +6,11 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "sim_host/hil/link/child.hpp"
+#include "sim_host/hil/link/transport.hpp"
 #include "sim_host/hil/options.hpp"
 #include "vines/link/config.hpp"
 #include "vines/link/frame.hpp"
@@ -21,11 +22,12 @@ using HilClock = std::chrono::steady_clock;
 
 double seconds_since(HilClock::time_point t0);
 
-// One node process and the bench's end of its link.
+// One node (a process, or a node on TCP) and the bench's end of its link.
 class NodeLink {
  public:
-  // Starts the node (opt.node, its image or command); its fault messages go
-  // to *faults, each with this process's life to *fault_life.
+  // Starts the node (opt.node, its image or command) or connects to it
+  // (tcp:HOST:PORT); its fault messages go to *faults, each with this
+  // node's life to *fault_life.
   NodeLink(const HilOptions& opt, long long life, std::vector<link::Fault>* faults,
            std::vector<long long>* fault_life);
 
@@ -57,10 +59,11 @@ class NodeLink {
   void set_epoch(HilClock::time_point t0) { t0_ = t0; }
   // Kills the node, then reads what it had sent.
   void kill();
-  int finish() { return child_.finish(opt_.timeout_s); }
+  int finish() { return link_->finish(opt_.timeout_s); }
 
  private:
   static std::vector<std::string> argv(const HilOptions& opt);
+  static std::unique_ptr<NodeTransport> open(const HilOptions& opt);
   // Reads and dispatches what came within timeout_s; false once the pipe ended.
   bool read(double timeout_s);
 
@@ -69,7 +72,7 @@ class NodeLink {
   std::vector<link::Fault>* faults_;
   std::vector<long long>* fault_life_;
   std::string name_;
-  ChildProcess child_;
+  std::unique_ptr<NodeTransport> link_;
   link::Decoder dec_;
   std::vector<std::uint8_t> buf_;
   std::uint16_t seq_ = 0;
