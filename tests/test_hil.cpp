@@ -13,19 +13,10 @@
 #include <sys/wait.h>
 
 #include "sim_host/hil/hil.hpp"
+#include "hil_support.hpp"
 
 namespace vines::host {
 namespace {
-
-Scene vines_scene() { return load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml"); }
-
-HilOptions base(double duration_s) {
-  HilOptions o;
-  o.node_command = VINES_EXE;
-  o.duration_s = duration_s;
-  o.timeout_s = 20;
-  return o;
-}
 
 // The counts of one fault kind (all -1 if none was injected).
 HilFaultCounts faults_of(const HilReport& r, const char* kind) {

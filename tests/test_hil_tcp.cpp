@@ -22,19 +22,10 @@
 #include "vines/bytes/wire.hpp"
 #include "vines/link/cobs.hpp"
 #include "vines/link/frame.hpp"
+#include "hil_support.hpp"
 
 namespace vines::host {
 namespace {
-
-Scene vines_scene() { return load_scene(std::string(VINES_SOURCE_DIR) + "/data/scenes/elcentro_vines.toml"); }
-
-HilOptions base(double duration_s) {
-  HilOptions o;
-  o.node_command = VINES_EXE;
-  o.duration_s = duration_s;
-  o.timeout_s = 20;
-  return o;
-}
 
 // `vines node --listen tcp:127.0.0.1:0` and the address it printed.
 struct Listener {
