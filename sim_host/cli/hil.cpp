@@ -172,7 +172,7 @@ void add_hil(CLI::App& vines) {
            const std::vector<std::string> names = host::node_names();
            if (std::find(names.begin(), names.end(), v) != names.end()) {
              opt.node = v;
-           } else if (v.rfind("tcp:", 0) == 0) {
+           } else if (host::is_tcp(v)) {
              try {
                host::parse_tcp_address(v, "", false);
              } catch (const std::runtime_error& e) {

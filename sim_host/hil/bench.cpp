@@ -86,7 +86,7 @@ void choose_node(Bench* b) {
     o.image = board_image(o, *b->board, b->scene);
     if (o.timeout_s <= 0) o.timeout_s = 60;  // QEMU boots, and takes ~20 kB/s
     b->scene.scalar = b->board->scalar;      // the board's scalar, whatever the scene says
-  } else if (o.node.rfind("tcp:", 0) == 0) {
+  } else if (is_tcp(o.node)) {
     parse_tcp_address(o.node, "", false);  // throws naming what is wrong
   } else if (o.node != "host") {
     throw std::runtime_error(refused);

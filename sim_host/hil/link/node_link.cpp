@@ -16,10 +16,10 @@ double seconds_since(HilClock::time_point t0) { return std::chrono::duration<dou
 NodeLink::NodeLink(const HilOptions& opt, long long life, std::vector<link::Fault>* faults,
                    std::vector<long long>* fault_life)
     : opt_(opt), life_(life), faults_(faults), fault_life_(fault_life),
-      name_(opt.node.rfind("tcp:", 0) == 0 ? opt.node : argv(opt)[0]), link_(open(opt)) {}
+      name_(is_tcp(opt.node) ? opt.node : argv(opt)[0]), link_(open(opt)) {}
 
 std::unique_ptr<NodeTransport> NodeLink::open(const HilOptions& opt) {
-  if (opt.node.rfind("tcp:", 0) == 0) return std::make_unique<TcpNode>(parse_tcp_address(opt.node, "", false), opt.timeout_s);
+  if (is_tcp(opt.node)) return std::make_unique<TcpNode>(parse_tcp_address(opt.node, "", false), opt.timeout_s);
   return std::make_unique<ChildProcess>(argv(opt));
 }
 
@@ -41,7 +41,7 @@ void NodeLink::send(const std::vector<std::uint8_t>& bytes) {
   try {
     link_->write_all(bytes.data(), bytes.size(), opt_.timeout_s);
   } catch (const std::runtime_error& e) {
-    if (name_.rfind("tcp:", 0) == 0) throw std::runtime_error("node " + name_ + ": the connection ended (" + e.what() + ")");
+    if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended (" + e.what() + ")");
     throw std::runtime_error(name_ + ": " + e.what());
   }
   delimiters_ += static_cast<std::uint32_t>(std::count(bytes.begin(), bytes.end(), 0));
@@ -52,7 +52,7 @@ void NodeLink::pump(double timeout_s) {
   // A node ends after answering STOP; before that, an exit is a failure.
   if (!open && acked_ < delimiters_) {
     const std::string unanswered = " with " + std::to_string(delimiters_ - acked_) + " frames unanswered";
-    if (name_.rfind("tcp:", 0) == 0) throw std::runtime_error("node " + name_ + ": the connection ended" + unanswered);
+    if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended" + unanswered);
     throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) + ")" +
                              unanswered);
   }

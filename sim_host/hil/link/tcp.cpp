@@ -53,7 +53,7 @@ void resolve(const TcpAddress& a, bool passive, Addresses* out) {
 }  // namespace
 
 TcpAddress parse_tcp_address(const std::string& text, const std::string& default_host, bool zero_ok) {
-  if (text.rfind("tcp:", 0) != 0) throw std::runtime_error(text + ": not a TCP address (tcp:HOST:PORT)");
+  if (!is_tcp(text)) throw std::runtime_error(text + ": not a TCP address (tcp:HOST:PORT)");
   const std::string rest = text.substr(4);
   TcpAddress a;
   if (!rest.empty() && rest[0] == '[') {

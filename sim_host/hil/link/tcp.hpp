@@ -15,6 +15,9 @@ struct TcpAddress {
   int port = 0;
 };
 
+// Whether a --node or --listen text names a TCP address ("tcp:...").
+inline bool is_tcp(const std::string& text) { return text.rfind("tcp:", 0) == 0; }
+
 // "tcp:HOST:PORT" ("tcp:[IPv6]:PORT"; "tcp:PORT" with default_host when it is
 // not empty). Throws std::runtime_error naming the text and what is wrong.
 // Port 0 (any free port) only where zero_ok (a node listening).

@@ -223,8 +223,8 @@ class TwinMode : public BenchMode {
     // impacts in most runs with none). The impulse: |F| integrated over them
     // and two samples on either side (over the whole run, the estimate's
     // noise, some 5 kN on the El Centro VI NES, made it up to 1.8 times the
-    // truth's); the truth's: |F| over the whole run. The mass the device floor gained, over
-    // the sphere's: a stuck sphere moves with its floor.
+    // truth's); the truth's: |F| over the whole run. The mass the device
+    // floor gained, over the sphere's: a stuck sphere moves with its floor.
     const double h = b_.h;
     std::vector<double> F;
     for (long long k = 0; k < rec.samples; ++k) {
