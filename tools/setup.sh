@@ -37,6 +37,7 @@ rest=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets
   libstdc++-arm-none-eabi-newlib                 # C++ headers/libs for it
   qemu-system-arm                                # runs the MCU images (ctest)
+  socat                                          # a pseudo-terminal pair: the serial node's test
   chromium                                       # the monitoring page's browser test
 )
 

@@ -122,7 +122,7 @@ int serve(link::Node<Plant, PortSink>& node, const PortSink& sink, const ServeOp
       node.on_byte(static_cast<std::uint8_t>(b), o.realtime ? now : 0);
       if (node.stopped()) return 0;
     } else if (now - last_byte > std::uint64_t{o.idle_limit_ms} * 1000000u) {
-      hal::console_write("vines node: no input within the idle limit, exiting\n");
+      hal::console_write("vines node: no input within the idle limit\n");
       return 1;
     }
     if (o.realtime) node.poll(hal::time_ns());

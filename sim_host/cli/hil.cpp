@@ -17,6 +17,7 @@
 #include "sim_host/cli/hil_print.hpp"
 #include "sim_host/cli/serve.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 #include "sim_host/hil/modes/twin_baseline.hpp"
 #include "sim_host/scene/scene.hpp"
@@ -172,9 +173,10 @@ void add_hil(CLI::App& vines) {
            const std::vector<std::string> names = host::node_names();
            if (std::find(names.begin(), names.end(), v) != names.end()) {
              opt.node = v;
-           } else if (host::is_tcp(v)) {
+           } else if (host::is_tcp(v) || host::is_serial(v)) {
              try {
-               host::parse_tcp_address(v, "", false);
+               if (host::is_tcp(v)) host::parse_tcp_address(v, "", false);
+               else host::parse_serial_address(v);
              } catch (const std::runtime_error& e) {
                throw CLI::ValidationError("--node", e.what());
              }
@@ -187,7 +189,9 @@ void add_hil(CLI::App& vines) {
          },
          host::node_list() + " (default host: `vines node`; qemu:TARGET: the board image in QEMU, in the "
          "board's scalar, instructions counted; build the preset first), tcp:HOST:PORT (a node that `vines node "
-         "--listen` runs, here or on another machine), or the path of a node program")
+         "--listen` runs, here or on another machine), serial:DEVICE[@BAUD] (a node on a serial line, raw 8N1, "
+         "default 921600 baud; the bench checks the line carries the run's frames at the sensor rate), or the path "
+         "of a node program")
       ->type_name("N");
   cmd->add_option("--image", opt.image,
                   "the board image to run (default: build/TARGET/firmware/app/vines_node_DEVICE.elf; in twin mode with "

@@ -1,11 +1,12 @@
 // `vines node`: the firmware node on stdin/stdout (what `vines hil` runs), or
-// on TCP for a bench elsewhere (--listen).
+// on TCP or a serial line for a bench elsewhere (--listen).
 #include <memory>
 #include <stdexcept>
 #include <string>
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 
 namespace vines::cli {
@@ -29,7 +30,8 @@ void add_node(CLI::App& vines) {
          "--listen",
          [a](const std::string& v) {
            try {
-             host::parse_tcp_address(v, "127.0.0.1", true);
+             if (host::is_serial(v)) host::parse_serial_address(v);
+             else host::parse_tcp_address(v, "127.0.0.1", true);
            } catch (const std::runtime_error& e) {
              throw CLI::ValidationError("--listen", e.what());
            }
@@ -37,8 +39,9 @@ void add_node(CLI::App& vines) {
          },
          "wait for a bench on TCP instead (`vines hil ... --node tcp:HOST:PORT`): one at a time, each a fresh "
          "node, until killed; HOST 127.0.0.1 unless given (0.0.0.0: every interface; the link has no "
-         "authentication, keep it on a lab network); PORT 0: a free one; prints where it listens")
-      ->type_name("tcp:[HOST:]PORT");
+         "authentication, keep it on a lab network); PORT 0: a free one; or on a serial line, raw 8N1 (default "
+         "921600 baud), a fresh node for each bench's run; prints where it listens")
+      ->type_name("tcp:[HOST:]PORT|serial:DEVICE[@BAUD]");
 }
 
 }  // namespace vines::cli

@@ -7,9 +7,12 @@
 #include <vector>
 
 #include "sim_host/engines/build_engine.hpp"
+#include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 #include "sim_host/hil/offline.hpp"
 #include "vines/link/ats.hpp"
+#include "vines/link/frame.hpp"
+#include "vines/link/messages.hpp"
 #include "vines/model/contact_laws.hpp"
 
 namespace vines::host {
@@ -88,6 +91,11 @@ void choose_node(Bench* b) {
     b->scene.scalar = b->board->scalar;      // the board's scalar, whatever the scene says
   } else if (is_tcp(o.node)) {
     parse_tcp_address(o.node, "", false);  // throws naming what is wrong
+  } else if (is_serial(o.node)) {
+    parse_serial_address(o.node);
+    if (o.faults[static_cast<int>(FaultKind::kRestart)].any())
+      throw std::runtime_error("--restart: the bench cannot cut the power of a node on a serial line (" + o.node +
+                               "); inject it with a pipe, QEMU or TCP node");
   } else if (o.node != "host") {
     throw std::runtime_error(refused);
   }
@@ -114,6 +122,24 @@ link::NodeConfig node_config(const Scene& scene, const HilOptions& opt) {
   c.budget_ticks = opt.budget_ticks;
   if (const char* why = link::validate_node(c)) throw std::runtime_error(why);
   return c;
+}
+
+// A frame's bytes on the wire at most: COBS's overhead and the delimiter.
+template <class Msg>
+std::size_t wire_bytes(const Msg& m) {
+  std::uint8_t payload[link::kMaxPayload];
+  return link::cobs_max_encoded(link::kHeaderBytes + link::encode(m, payload, sizeof payload) + link::kCrcBytes) + 1;
+}
+
+// A node on a serial line: the samples' frames and the telemetry's must fit
+// the line at the sensor rate (lock step or real time alike).
+void check_serial_line(const Bench& b) {
+  if (!is_serial(b.opt.node)) return;
+  link::Sample s;
+  s.ny = static_cast<std::uint8_t>(b.cfg.estimator == link::TwinEstimator::kKalman ? b.twin.sensors.size() : 0);
+  link::Telemetry t;
+  t.n = static_cast<std::uint8_t>(b.scene.params.frame.stories);
+  check_line_rate(parse_serial_address(b.opt.node), 1.0 / b.h, wire_bytes(s), wire_bytes(t));
 }
 
 }  // namespace
@@ -153,6 +179,7 @@ Bench make_bench(const Scene& scene, const HilOptions& opt) {
   b.cfg = node_config(sc, o);
   if (o.mode == HilMode::kTwin) b.twin = make_twin_bench(sc, o, b.ex);
   b.image = b.cfg.estimator == link::TwinEstimator::kKalman ? b.twin.design.image : model_image(b.cfg, sc.path);
+  check_serial_line(b);
   return b;
 }
 

@@ -1,5 +1,5 @@
 // Byte I/O on a non-blocking file descriptor (a pipe or a socket) with
-// timeouts: what every transport to a node shares (child.hpp, tcp.hpp).
+// timeouts: what the transports to a node share (child.hpp, tcp.hpp, serial.hpp).
 #pragma once
 
 #include <cstddef>

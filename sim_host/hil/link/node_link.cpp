@@ -5,6 +5,7 @@
 
 #include "sim_host/hil/link/boards.hpp"
 #include "sim_host/hil/link/child.hpp"
+#include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 
 namespace vines::host {
@@ -16,10 +17,11 @@ double seconds_since(HilClock::time_point t0) { return std::chrono::duration<dou
 NodeLink::NodeLink(const HilOptions& opt, long long life, std::vector<link::Fault>* faults,
                    std::vector<long long>* fault_life)
     : opt_(opt), life_(life), faults_(faults), fault_life_(fault_life),
-      name_(is_tcp(opt.node) ? opt.node : argv(opt)[0]), link_(open(opt)) {}
+      name_(is_tcp(opt.node) || is_serial(opt.node) ? opt.node : argv(opt)[0]), link_(open(opt)) {}
 
 std::unique_ptr<NodeTransport> NodeLink::open(const HilOptions& opt) {
   if (is_tcp(opt.node)) return std::make_unique<TcpNode>(parse_tcp_address(opt.node, "", false), opt.timeout_s);
+  if (is_serial(opt.node)) return std::make_unique<SerialNode>(parse_serial_address(opt.node));
   return std::make_unique<ChildProcess>(argv(opt));
 }
 
@@ -41,7 +43,9 @@ void NodeLink::send(const std::vector<std::uint8_t>& bytes) {
   try {
     link_->write_all(bytes.data(), bytes.size(), opt_.timeout_s);
   } catch (const std::runtime_error& e) {
-    if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended (" + e.what() + ")");
+    if (is_tcp(name_) || is_serial(name_))
+      throw std::runtime_error("node " + name_ + ": the " + (is_tcp(name_) ? "connection" : "line") + " ended (" +
+                               e.what() + ")");
     throw std::runtime_error(name_ + ": " + e.what());
   }
   delimiters_ += static_cast<std::uint32_t>(std::count(bytes.begin(), bytes.end(), 0));
@@ -52,7 +56,9 @@ void NodeLink::pump(double timeout_s) {
   // A node ends after answering STOP; before that, an exit is a failure.
   if (!open && acked_ < delimiters_) {
     const std::string unanswered = " with " + std::to_string(delimiters_ - acked_) + " frames unanswered";
-    if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended" + unanswered);
+    if (is_tcp(name_) || is_serial(name_))
+      throw std::runtime_error("node " + name_ + ": the " + (is_tcp(name_) ? "connection" : "line") + " ended" +
+                               unanswered);
     throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) + ")" +
                              unanswered);
   }
@@ -144,6 +150,10 @@ void configure(NodeLink& node, const link::NodeConfig& cfg, const std::vector<st
   if (n == 0) throw std::runtime_error("configuration does not fit the link");
   send_part(node, link::ConfigPart::kSettings, blob, n);
   node.wait_answered();
+  if (node.statuses() == 0)  // faults only: a serial node whose line outlived the last bench
+    throw std::runtime_error("node " + node.name() + " answered the configuration with faults only: it is still in "
+                             "another bench's run, and takes a new one after its --idle-timeout of silence (30 s "
+                             "unless set)");
   if (node.status().state != link::NodeState::kConfigured)
     throw std::runtime_error(std::string("node refused the configuration: ") + node.status().message);
 }

@@ -56,6 +56,8 @@ class NodeLink {
   // The node's first status said it had just powered up (state lost).
   bool first_cold_start() const { return first_cold_start_; }
   long long bad_frames() const { return bad_frames_; }
+  long long statuses() const { return statuses_; }  // status messages received
+  const std::string& name() const { return name_; }
   void set_epoch(HilClock::time_point t0) { t0_ = t0; }
   // Kills the node, then reads what it had sent.
   void kill();

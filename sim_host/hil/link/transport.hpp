@@ -1,7 +1,8 @@
 // The bench's byte path to one node: a child process over pipes
-// (child.hpp: `vines node`, a board in QEMU) or a node listening on TCP
-// (tcp.hpp: `vines node --listen`, another machine beside the table). The
-// link protocol on top is the same (node_link.hpp).
+// (child.hpp: `vines node`, a board in QEMU), a node listening on TCP
+// (tcp.hpp: `vines node --listen`, another machine beside the table) or one
+// on a serial line (serial.hpp: a board on a USB serial port). The link
+// protocol on top is the same (node_link.hpp).
 #pragma once
 
 #include <cstddef>
@@ -20,7 +21,7 @@ class NodeTransport {
   virtual bool read_some(std::vector<std::uint8_t>* out, double timeout_s) = 0;
   // Ends the link and waits up to timeout_s for the node to end its side:
   // its exit status (a process; 128 + signal if killed), or 0 when a TCP
-  // node closed the connection in time (1 if not).
+  // node closed the connection in time (1 if not), or a serial line drained.
   virtual int finish(double timeout_s) = 0;
   // Cuts the node off now (a power cut): a process killed, a connection reset.
   virtual void kill_now() = 0;
