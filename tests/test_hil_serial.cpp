@@ -85,22 +85,7 @@ TEST(HilSerial, NodeOnASerialLineEqualsThePipeRunAndSurvivesEveryFault) {
   // data lines (refused below); the node on the line serves run after run.
   const FaultKind kinds[] = {FaultKind::kDrop, FaultKind::kCorrupt, FaultKind::kDuplicate,
                              FaultKind::kReorder, FaultKind::kLate, FaultKind::kNonFinite, FaultKind::kStall};
-  for (FaultKind k : kinds) {
-    HilOptions o = base(3.0), s = serial;
-    o.faults[static_cast<int>(k)] = s.faults[static_cast<int>(k)] = parse_fault_spec("--x", "@700,1400,2100");
-    const HilReport p = run_hil(vines_scene(), o), r = run_hil(vines_scene(), s);
-    const char* name = fault_kind_name(k);
-    SCOPED_TRACE(name);
-    ASSERT_EQ(r.faults.count(name), 1u);
-    EXPECT_EQ(r.faults.at(name).detected, 3);
-    EXPECT_EQ(r.faults.at(name).survived, 3);
-    EXPECT_TRUE(r.survived);
-    EXPECT_EQ(r.bit_exact, p.bit_exact);
-    EXPECT_EQ(r.max_deviation_from_offline, p.max_deviation_from_offline);
-    EXPECT_EQ(r.faults.at(name).deviation_m, p.faults.at(name).deviation_m);
-    EXPECT_EQ(r.node_faults, p.node_faults);
-    EXPECT_EQ(r.steps, p.steps);
-  }
+  for (FaultKind k : kinds) expect_fault_as_over_pipes(serial, k);
   HilOptions cut = serial;
   cut.faults[static_cast<int>(FaultKind::kRestart)] = parse_fault_spec("--restart", "@700");
   EXPECT_NE(run_error(vines_scene(), cut).find("--restart: the bench cannot cut the power of a node on a serial line"),
@@ -109,17 +94,18 @@ TEST(HilSerial, NodeOnASerialLineEqualsThePipeRunAndSurvivesEveryFault) {
 
 // Refused before a byte is sent: the El Centro VI NES scene at 1 kHz sends
 // 47-byte samples and gets 270-byte telemetry back (10 stories), which
-// 921600 baud (92,160 bytes/s) cannot carry; 3,000,000 baud can.
+// 921600 baud (92,160 bytes/s) cannot carry; 3,000,000 baud (the default)
+// can.
 TEST(HilSerial, ALineTooSlowForTheRateIsRefusedWithBothFigures) {
   HilOptions o = base(1.0);
-  o.node = "serial:/dev/null-no-such-line";  // never opened: the check comes first
+  o.node = "serial:/dev/null-no-such-line@921600";  // never opened: the check comes first
   const std::string e = run_error(vines_scene(), o);
   EXPECT_NE(e.find("the line carries 92,160 bytes/s each way"), std::string::npos) << e;
   EXPECT_NE(e.find("this run needs 270,000 bytes/s (47 bytes a sample to the node, 270 back, at 1,000 Hz)"),
             std::string::npos)
       << e;
   EXPECT_NE(e.find("set @3000000 or more"), std::string::npos) << e;
-  o.node = "serial:/dev/null-no-such-line@3000000";  // fast enough: now the device is looked for
+  o.node = "serial:/dev/null-no-such-line";  // the default baud: now the device is looked for
   EXPECT_NE(run_error(vines_scene(), o).find("No such file or directory (is the board plugged in?"), std::string::npos);
   o.node = "serial:/dev/null@3000000";
   EXPECT_NE(run_error(vines_scene(), o).find("not a serial line"), std::string::npos);

@@ -55,24 +55,7 @@ TEST(HilTcp, NodeOnTcpEqualsThePipeRunAndSurvivesEveryFault) {
   EXPECT_EQ(clean.node_status.exit_status, 0);  // the node closed the link after STOP
   const FaultKind kinds[] = {FaultKind::kDrop, FaultKind::kCorrupt, FaultKind::kDuplicate, FaultKind::kReorder,
                              FaultKind::kLate, FaultKind::kNonFinite, FaultKind::kStall, FaultKind::kRestart};
-  for (FaultKind k : kinds) {
-    HilOptions o = base(3.0), t = tcp;
-    o.faults[static_cast<int>(k)] = t.faults[static_cast<int>(k)] = parse_fault_spec("--x", "@700,1400,2100");
-    const HilReport p = run_hil(vines_scene(), o), r = run_hil(vines_scene(), t);
-    const char* name = fault_kind_name(k);
-    SCOPED_TRACE(name);
-    ASSERT_EQ(r.faults.count(name), 1u);
-    EXPECT_EQ(r.faults.at(name).detected, 3);
-    EXPECT_EQ(r.faults.at(name).survived, 3);
-    EXPECT_TRUE(r.survived);
-    // The same run as over the pipes: every output, and each fault's effect.
-    EXPECT_EQ(r.bit_exact, p.bit_exact);
-    EXPECT_EQ(r.max_deviation_from_offline, p.max_deviation_from_offline);
-    EXPECT_EQ(r.faults.at(name).deviation_m, p.faults.at(name).deviation_m);
-    EXPECT_EQ(r.node_faults, p.node_faults);
-    EXPECT_EQ(r.node_restarts, p.node_restarts);
-    EXPECT_EQ(r.steps, p.steps);
-  }
+  for (FaultKind k : kinds) expect_fault_as_over_pipes(tcp, k);
 }
 
 TEST(HilTcp, ANodeNotThereOrGoneIsNamed) {
@@ -111,8 +94,9 @@ TEST(HilTcp, ANodeNotThereOrGoneIsNamed) {
   EXPECT_FALSE(std::ifstream(o.csv).good());
 }
 
-// A node built from another checkout: its first answer, a whole frame with a
-// good CRC in protocol version 99, stops the bench saying so.
+// A node built from another checkout: its first frame, the status it sends
+// unasked when a bench connects, whole and with a good CRC in protocol
+// version 99, stops the bench saying so.
 TEST(HilTcp, ANodeOfAnotherProtocolVersionIsNamed) {
   int port = 0;
   const int listener = listen_tcp(TcpAddress{"127.0.0.1", 0}, &port);
@@ -126,9 +110,7 @@ TEST(HilTcp, ANodeOfAnotherProtocolVersionIsNamed) {
     w.u32(link::crc32(raw, w.size()));
     const std::size_t n = link::cobs_encode(raw, w.size(), wire, sizeof wire);
     wire[n] = 0;
-    std::uint8_t in[4096];
-    (void)::read(fd, in, sizeof in);  // the bench's first frames
-    (void)::write(fd, wire, n + 1);
+    (void)::write(fd, wire, n + 1);  // its announcement (docs/link_protocol.md, "Session")
     std::this_thread::sleep_for(std::chrono::seconds(2));
     ::close(fd);
   });

@@ -59,7 +59,7 @@ Figures, per target and mode (VI NES image, that mode's runs):
   flash_bytes   .isr_vector .text .ARM.extab .ARM.exidx .preinit_array
                 .init_array and .data's load image
   ram_bytes     .data + .bss + .stack - __stack_guard_size: .stack
-                (mps2_sections.ld) is the 32 KiB no-access MPU guard at the
+                (sections.ld) is the 32 KiB no-access MPU guard at the
                 bottom of RAM, the process stack (__stack_size) and the
                 handler stack (__handler_stack_size); the guard holds no data
                 and is not counted (ram_bytes_with_guard includes it)

@@ -134,11 +134,14 @@ int serve(link::Node<Plant, PortSink>& node, const PortSink& sink, const ServeOp
 }
 
 // A board's main(): the stack painted for its high-water mark, the port
-// opened, the node served in lock step until STOP (0) or 10 s of silence (1).
+// opened, a status sent unasked (the bench waits for it: what it sent
+// before the UART was on is lost), the node served in lock step until STOP
+// (0) or 10 s of silence (1).
 template <class Plant>
 int board_main(link::Node<Plant, PortSink>& node, const PortSink& sink) {
   hal::stack_paint();
   hal::port_init();
+  node.announce();
   ServeOptions o;
   o.idle_limit_ms = 10000;
   return serve(node, sink, o);

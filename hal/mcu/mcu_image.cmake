@@ -14,6 +14,20 @@ if(NOT EXISTS ${VINES_MCU_LINKER_SCRIPT})
 endif()
 find_program(VINES_MCU_SIZE_TOOL arm-none-eabi-size REQUIRED)
 
+# The port (vines/hal/port.hpp) of the board's chip, for the images that use
+# it: the MPS2's CMSDK peripherals, or the STM32F405's (netduinoplus2), each
+# beside what every Cortex-M board shares.
+if(VINES_MCU_BOARD MATCHES "^mps2-")
+  set(VINES_MCU_PORT_SOURCES ${VINES_MCU_DIR}/port_mps2.cpp)
+elseif(VINES_MCU_BOARD STREQUAL "netduinoplus2")
+  set(VINES_MCU_PORT_SOURCES ${VINES_MCU_DIR}/port_stm32f405.cpp ${VINES_MCU_DIR}/stm32f405_board.cpp)
+else()
+  message(FATAL_ERROR "board machine '${VINES_MCU_BOARD}': no port for its chip (hal/mcu/port_*.cpp)")
+endif()
+list(APPEND VINES_MCU_PORT_SOURCES ${VINES_MCU_DIR}/port_cortex_m.cpp)
+option(VINES_STM32F405_PHYSICAL
+  "STM32F405 images for a physical board: bring up its crystal and PLL (QEMU models no clock tree)" OFF)
+
 # Heap ban. Every allocator entry point of newlib and every C++ operator
 # new/delete (size_t is `unsigned int`, mangled `j`, on arm-none-eabi) is
 # wrapped: ld --wrap=SYM turns each undefined reference to SYM into one to
@@ -39,12 +53,13 @@ list(TRANSFORM VINES_MCU_NO_HEAP_LINK_OPTIONS PREPEND "-Wl,--wrap=")
 function(vines_mcu_image target)
   target_sources(${target} PRIVATE ${VINES_MCU_DIR}/startup.c)
   target_include_directories(${target} PRIVATE ${VINES_MCU_DIR})
+  target_compile_definitions(${target} PRIVATE VINES_STM32F405_PHYSICAL=$<BOOL:${VINES_STM32F405_PHYSICAL}>)
   target_link_options(${target} PRIVATE
     -nostartfiles -L${VINES_MCU_DIR} -T${VINES_MCU_LINKER_SCRIPT}
     -Wl,-Map=$<TARGET_FILE_DIR:${target}>/${target}.map
     ${VINES_MCU_NO_HEAP_LINK_OPTIONS})
   set_target_properties(${target} PROPERTIES
-    SUFFIX .elf LINK_DEPENDS "${VINES_MCU_LINKER_SCRIPT};${VINES_MCU_DIR}/mps2_sections.ld")
+    SUFFIX .elf LINK_DEPENDS "${VINES_MCU_LINKER_SCRIPT};${VINES_MCU_DIR}/sections.ld")
   add_custom_command(TARGET ${target} POST_BUILD
     COMMAND ${VINES_MCU_SIZE_TOOL} $<TARGET_FILE:${target}>)
 endfunction()

@@ -1,10 +1,10 @@
-// MCU backend of vines/hal/port.hpp for the MPS2 boards (AN386, AN500): the
-// CMSDK APB peripherals at the same addresses on both (QEMU hw/arm/mps2.c).
+// MCU backend of vines/hal/port.hpp for the MPS2 boards (AN385, AN386,
+// AN500): the CMSDK APB peripherals at the same addresses on all three (QEMU
+// hw/arm/mps2.c); port_cortex_m.cpp has the parts every board shares.
 //   UART0  0x40004000  the link (frames in and out), polled (1-byte buffers)
 //   TIMER1 0x40001000  free-running down-counter at the 25 MHz APB clock
 #include <cstdint>
 
-#include "semihost.h"
 #include "vines/hal/port.hpp"
 
 namespace {
@@ -26,15 +26,9 @@ enum : std::uint32_t {
 Uart& uart0() { return *reinterpret_cast<Uart*>(0x40004000u); }
 Timer& timer1() { return *reinterpret_cast<Timer*>(0x40001000u); }
 
-constexpr std::uint32_t kPaint = 0xA5A5A5A5u;
-
 const char* g_error = "";
-std::uint64_t g_time_ticks = 0;  // counter extended to 64 bits by time_ns()
-std::uint32_t g_time_last = 0;
 
 }  // namespace
-
-extern "C" std::uint32_t __stack_limit[], __stack_top[];  // mps2_sections.ld
 
 namespace vines::hal {
 
@@ -69,30 +63,7 @@ bool link_write(const void* src, std::size_t n) {
 
 const char* port_error() { return g_error; }
 
-void console_write(const char* text) { vines_semihost_puts(text); }
-
 std::uint32_t counter_now() { return ~timer1().value; }  // counts up
 std::uint32_t counter_hz() { return kPclkHz; }
-std::uint64_t time_ns() {
-  const std::uint32_t now = counter_now();
-  g_time_ticks += now - g_time_last;
-  g_time_last = now;
-  return 1 + g_time_ticks * (1000000000u / kPclkHz);
-}
-
-void stack_paint() {
-  std::uint32_t* sp;
-  __asm__ volatile("mov %0, sp" : "=r"(sp));
-  for (std::uint32_t* p = __stack_limit; p < sp - 16; ++p) *const_cast<volatile std::uint32_t*>(p) = kPaint;
-}
-
-std::uint32_t stack_peak_bytes() {
-  const std::uint32_t* p = __stack_limit;
-  while (p < __stack_top && *const_cast<const volatile std::uint32_t*>(p) == kPaint) ++p;
-  return static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(__stack_top) - reinterpret_cast<std::uintptr_t>(p));
-}
-
-void irq_off() { __asm__ volatile("cpsid i" ::: "memory"); }
-void irq_on() { __asm__ volatile("cpsie i" ::: "memory"); }
 
 }  // namespace vines::hal

@@ -2,7 +2,7 @@
  * table, reset handler (FPU on, thread mode on the process stack, MPU stack
  * guard, .data/.bss, constructors, main), fault handlers, and the C/C++
  * runtime hooks that would otherwise pull stdio/heap code out of newlib and
- * libstdc++. Symbols come from mps2_sections.ld. Faults and failed checks end the run through
+ * libstdc++. Symbols come from sections.ld. Faults and failed checks end the run through
  * semihosting (semihost.h) with a non-zero exit status; main's return value is
  * the exit status. */
 #include <stdint.h>

@@ -190,7 +190,7 @@ void add_hil(CLI::App& vines) {
          host::node_list() + " (default host: `vines node`; qemu:TARGET: the board image in QEMU, in the "
          "board's scalar, instructions counted; build the preset first), tcp:HOST:PORT (a node that `vines node "
          "--listen` runs, here or on another machine), serial:DEVICE[@BAUD] (a node on a serial line, raw 8N1, "
-         "default 921600 baud; the bench checks the line carries the run's frames at the sensor rate), or the path "
+         "default 3000000 baud; the bench checks the line carries the run's frames at the sensor rate), or the path "
          "of a node program")
       ->type_name("N");
   cmd->add_option("--image", opt.image,

@@ -40,7 +40,7 @@ void add_node(CLI::App& vines) {
          "wait for a bench on TCP instead (`vines hil ... --node tcp:HOST:PORT`): one at a time, each a fresh "
          "node, until killed; HOST 127.0.0.1 unless given (0.0.0.0: every interface; the link has no "
          "authentication, keep it on a lab network); PORT 0: a free one; or on a serial line, raw 8N1 (default "
-         "921600 baud), a fresh node for each bench's run; prints where it listens")
+         "3000000 baud), a fresh node for each bench's run; prints where it listens")
       ->type_name("tcp:[HOST:]PORT|serial:DEVICE[@BAUD]");
 }
 

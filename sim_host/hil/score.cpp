@@ -199,8 +199,8 @@ void score_node(const Bench& b, const HilRecord& rec, HilReport* r) {
   r->step_ticks = stats(ticks);
   if (b.board && !ticks.empty()) {
     std::sort(ticks.begin(), ticks.end());
-    r->board = HilBoardSteps{kIcountShift, kInstructionsPerTick * tm.worst_ticks, tm.worst_k,
-                             kInstructionsPerTick * ticks[ticks.size() / 2]};
+    const double per_tick = instructions_per_tick(tm.counter_hz);
+    r->board = HilBoardSteps{kIcountShift, per_tick * tm.worst_ticks, tm.worst_k, per_tick * ticks[ticks.size() / 2]};
   }
 }
 

@@ -2,6 +2,7 @@
 // machine, the scalar and the preset whose build holds the board images.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -18,9 +19,12 @@ struct Board {
 };
 
 // QEMU runs the boards with -icount shift=3: one instruction per 8 ns of
-// virtual time, so one tick of the 25 MHz counter is 5 instructions.
+// virtual time, so one tick of the MPS2's 25 MHz counter is 5 instructions,
+// one of the STM32F405's 168 MHz SysTick 0.744.
 inline constexpr int kIcountShift = 3;
-inline constexpr double kInstructionsPerTick = 40.0 / (1 << kIcountShift);
+inline double instructions_per_tick(std::uint32_t counter_hz) {
+  return counter_hz ? 1e9 / counter_hz / (1 << kIcountShift) : 0.0;
+}
 
 // The nodes HilOptions::node names: "host", then "qemu:TARGET" for each board.
 std::vector<std::string> node_names();

@@ -38,6 +38,7 @@ int serve_link(bool realtime, double idle_timeout_s) {
   app::PortSink sink;
   auto node = std::make_unique<link::Node<Timed, app::PortSink>>(timed.get(), &sink);
   hal::port_init();
+  node->announce();  // as a board does once its UART is on: the bench waits for it
   return app::serve(*node, sink, o);
 }
 

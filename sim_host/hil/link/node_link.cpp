@@ -113,6 +113,22 @@ bool NodeLink::read(double timeout_s) {
   return open;
 }
 
+void NodeLink::await_announce() {
+  if (is_serial(opt_.node)) return;
+  const auto end = HilClock::now() + std::chrono::duration<double>(opt_.timeout_s);
+  while (statuses_ == 0) {
+    const double left = std::chrono::duration<double>(end - HilClock::now()).count();
+    if (left <= 0)
+      throw std::runtime_error("node " + name_ + ": no answer within " + std::to_string(opt_.timeout_s) +
+                               " s: it did not say it listens (--timeout)");
+    if (!read(std::min(left, 0.05)) && statuses_ == 0) {
+      if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended before it said it listens");
+      throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) +
+                               ") before it said it listens");
+    }
+  }
+}
+
 void NodeLink::wait_answered(std::uint32_t in_flight) {
   const auto end = HilClock::now() + std::chrono::duration<double>(opt_.timeout_s);
   while (acked_ + in_flight < delimiters_) {
@@ -139,6 +155,7 @@ void send_part(NodeLink& node, link::ConfigPart part, const std::uint8_t* bytes,
 }  // namespace
 
 void configure(NodeLink& node, const link::NodeConfig& cfg, const std::vector<std::uint8_t>& image) {
+  node.await_announce();
   if (!image.empty()) {
     send_part(node, link::ConfigPart::kModelImage, image.data(), image.size());
     node.wait_answered();

@@ -47,6 +47,10 @@ class NodeLink {
   void send(const std::vector<std::uint8_t>& bytes);
   // Reads and dispatches what the node sent within timeout_s.
   void pump(double timeout_s);
+  // Waits for the status a node sends unasked when it starts (a board once
+  // its UART is on: what came before is lost; docs/link_protocol.md), but
+  // on a serial line, whose node started before the bench opened it.
+  void await_announce();
   // Waits until at most `in_flight` frames sent are still unanswered (0:
   // lock step).
   void wait_answered(std::uint32_t in_flight = 0);

@@ -12,7 +12,9 @@
 
 namespace vines::host {
 
-inline constexpr long kDefaultBaud = 921600;  // what most USB-UART bridges reach
+// The board images' UART (hal/mcu/stm32f405_board.hpp): what a 10-story node
+// at 1 kHz needs, and what FTDI and CP2102N bridges reach.
+inline constexpr long kDefaultBaud = 3000000;
 
 struct SerialAddress {
   std::string device;  // /dev/ttyUSB0, /dev/ttyACM0, a pty

@@ -63,6 +63,10 @@ class Node {
     if (tx_frames_ == sent) send_status();
   }
 
+  // A status unasked: a board that has just powered up says it listens (a
+  // UART drops what came before it was enabled; the bench waits for this).
+  void announce() { send_status(); }
+
   // Runs deadlines that have passed by local time local_ns (real-time clock).
   void poll(std::uint64_t local_ns) { advance_clock(local_ns, 0); }
 
