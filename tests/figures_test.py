@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """tools/figures.py and tools/plot_bench.py on small `vines bench --csv` files:
 the table's rows and stamp, and the refusals (exit 2 naming the file); the
-parts of tools/test.sh from a small log.
+parts of tools/test.sh from a small log; the deadlines with and without
+real-time service from two runs.
 
 Usage: figures_test.py REPO_ROOT
 """
@@ -79,6 +80,32 @@ with tempfile.TemporaryDirectory() as tmp:
     r = run(FIGURES, "test-times", good, "--out", os.path.join(tmp, "x.out"))
     check("test times: a file without laps is refused, naming it",
           r.returncode == 2 and f"figures.py: {good}: no 'test.sh: " in r.stderr and not os.path.exists(os.path.join(tmp, "x.out")))
+
+    # The deadlines with and without real-time service: one row a run, what
+    # the OS granted each process, or what it refused.
+    runs = os.path.join(tmp, "rt.jsonl")
+    lat = '"latency_us": {"mean": 12.4, "p99": 40.2, "max": 900.0}'
+    granted = ('{"policy": "fifo", "priority": 80, "memory_locked": true, "cpus": [1], "refused": []}')
+    refused = ('{"policy": "other", "priority": 0, "memory_locked": false, "cpus": [0, 1], '
+               '"refused": ["SCHED_FIFO priority 80: Operation not permitted"]}')
+    with open(runs, "w") as f:
+        f.write('{"kind": "real-time service", "round": 1, "load": 0.1, "steps": 20001, "deadline_misses": 1, '
+                f'{lat}, "service": {{"bench": {refused}, "node": {granted}}}}}\n')
+        f.write(f'{{"kind": "time-shared", "round": 1, "load": 0.0, "steps": 20001, "deadline_misses": 50, {lat}, '
+                '"service": null}\n')
+    out = os.path.join(tmp, "figures", "realtime_deadlines.md")
+    r = run(FIGURES, "realtime", runs, "--out", out)
+    text = open(out).read() if os.path.exists(out) else ""
+    check("real-time deadlines: time-shared first, misses in %, each process's service",
+          r.returncode == 0 and text.find("| time-shared |") < text.find("| real-time service |")
+          and "| time-shared | 1 | 0.00 | 20001 | 50 | 0.250 | 12 / 40 / 900 | - | - |" in text
+          and "| 0.005 | 12 / 40 / 900 | other; refused SCHED_FIFO priority 80: Operation not permitted | "
+              "FIFO 80, locked, core 1 |" in text)
+    with open(runs, "w") as f:
+        f.write(f'{{"kind": "time-shared", "round": 1, "load": 0.0, "steps": 20001, "deadline_misses": 50, {lat}}}\n')
+    r = run(FIGURES, "realtime", runs, "--out", os.path.join(tmp, "x.out"))
+    check("real-time deadlines: a run without its service is refused, naming the file",
+          r.returncode == 2 and f"figures.py: {runs}: a run without 'service'" in r.stderr)
 
 print(f"figures_test: {len(failures)} failed")
 sys.exit(1 if failures else 0)

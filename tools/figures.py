@@ -4,11 +4,13 @@ that measured it, stamped with the date, the commit and the machine, so that no
 figure in the guides is edited by hand (docs/figures/README.md).
 
 As a module (tools/mcu_report.py, tools/twin_benchmark.py): stamp() and write().
-As a command, the work-precision table of a `vines bench --csv` file, or the
-bench's deadlines with and without the monitoring page (tools/page_deadlines.sh):
+As a command, the work-precision table of a `vines bench --csv` file, the
+bench's deadlines with and without the monitoring page (tools/page_deadlines.sh)
+or real-time service (tools/realtime_deadlines.sh), the parts of tools/test.sh:
 
   figures.py bench BENCH.csv [--out docs/figures/bench.md] [--command CMD]
   figures.py deadlines RUNS.jsonl [--out docs/figures/page_deadlines.md] [--command CMD]
+  figures.py realtime RUNS.jsonl [--out docs/figures/realtime_deadlines.md] [--command CMD]
   figures.py test-times TEST.log [--out docs/figures/test_times.md] [--command CMD]
 
 Exit code 2, with a message naming the path, on a missing file or column.
@@ -147,8 +149,8 @@ def bench_body(path):
 DEADLINE_KINDS = ["no page", "served, no client", "stream read, no browser", "page open"]
 
 
-def deadlines_body(path):
-    """The table of tests/browser/deadlines.js's JSON lines: one row a run."""
+def _runs(path, keys):
+    """The runs of a JSON-lines file, each with keys."""
     try:
         with open(path) as f:
             runs = [json.loads(line) for line in f if line.strip()]
@@ -157,20 +159,55 @@ def deadlines_body(path):
     except json.JSONDecodeError as e:
         fail("figures.py", f"{path}: line {e.lineno}: not JSON ({e.msg})")
     for r in runs:
-        for key in ("kind", "round", "load", "steps", "deadline_misses", "latency_us"):
+        for key in keys:
             if key not in r:
                 fail("figures.py", f"{path}: a run without '{key}'")
     if not runs:
         fail("figures.py", f"{path}: no runs")
+    return runs
+
+
+def _deadline_row(r):
+    lat = r["latency_us"]
+    return [r["kind"], r["round"], f"{r['load']:.2f}", r["steps"], r["deadline_misses"],
+            f"{100 * r['deadline_misses'] / r['steps']:.3f}", f"{lat['mean']:.0f} / {lat['p99']:.0f} / {lat['max']:.0f}"]
+
+
+DEADLINE_HEADER = ["run", "round", "load before", "steps", "deadline misses", "misses %",
+                   "latency mean / p99 / max (us)"]
+
+
+def deadlines_body(path):
+    """The table of tests/browser/deadlines.js's JSON lines: one row a run."""
+    runs = _runs(path, ("kind", "round", "load", "steps", "deadline_misses", "latency_us"))
+    rows = [_deadline_row(r) + ["-" if r.get("page_samples") is None else r["page_samples"]]
+            for r in sorted(runs, key=lambda r: (DEADLINE_KINDS.index(r["kind"]), r["round"]))]
+    return table(DEADLINE_HEADER + ["samples on the page"], rows)
+
+
+# ---- the bench's deadlines with and without real-time service ----
+
+REALTIME_KINDS = ["time-shared", "real-time service"]
+
+
+def _service(s):
+    """One process's service as the report gives it: "FIFO 80, locked, core 1" or what was refused."""
+    if not s:
+        return "-"
+    text = ("FIFO " + str(s["priority"]) if s["policy"] == "fifo" else s["policy"]) + \
+        (", locked" if s["memory_locked"] else "") + \
+        (f", core {s['cpus'][0]}" if len(s["cpus"]) == 1 else "")
+    return text + "".join(f"; refused {r}" for r in s["refused"])
+
+
+def realtime_body(path):
+    """The table of tools/realtime_deadlines.sh's JSON lines: one row a run."""
+    runs = _runs(path, ("kind", "round", "load", "steps", "deadline_misses", "latency_us", "service"))
     rows = []
-    for r in sorted(runs, key=lambda r: (DEADLINE_KINDS.index(r["kind"]), r["round"])):
-        lat = r["latency_us"]
-        page = r.get("page_samples")
-        rows.append([r["kind"], r["round"], f"{r['load']:.2f}", r["steps"], r["deadline_misses"],
-                     f"{100 * r['deadline_misses'] / r['steps']:.2f}",
-                     f"{lat['mean']:.0f} / {lat['p99']:.0f} / {lat['max']:.0f}", "-" if page is None else page])
-    return table(["run", "round", "load before", "steps", "deadline misses", "misses %",
-                  "latency mean / p99 / max (us)", "samples on the page"], rows)
+    for r in sorted(runs, key=lambda r: (REALTIME_KINDS.index(r["kind"]), r["round"])):
+        s = r["service"] or {}
+        rows.append(_deadline_row(r) + [_service(s.get("bench")), _service(s.get("node"))])
+    return table(DEADLINE_HEADER + ["bench", "node"], rows)
 
 
 # ---- the parts of tools/test.sh and their times ----
@@ -204,6 +241,11 @@ def main():
     d.add_argument("jsonl")
     d.add_argument("--out", default=os.path.join(FIGURES, "page_deadlines.md"))
     d.add_argument("--command", default="bash tools/page_deadlines.sh")
+    rt = sub.add_parser("realtime", help="the bench's deadlines with and without real-time service "
+                        "(tools/realtime_deadlines.sh)")
+    rt.add_argument("jsonl")
+    rt.add_argument("--out", default=os.path.join(FIGURES, "realtime_deadlines.md"))
+    rt.add_argument("--command", default="bash tools/realtime_deadlines.sh")
     t = sub.add_parser("test-times", help="the parts of tools/test.sh and their times, from its output")
     t.add_argument("log")
     t.add_argument("--out", default=os.path.join(FIGURES, "test_times.md"))
@@ -215,6 +257,17 @@ def main():
                "tests, the sanitizer subset (preset `sanitize`), then each board's images and their tests in",
                "QEMU. CI allows 90 minutes for the whole, `tools/setup.sh` included.", ""]
               + test_times_body(a.log))
+        print(f"figures.py: wrote {a.out}")
+        return
+    if a.what == "realtime":
+        write(a.out, "The bench's deadlines with and without real-time service", a.command,
+              ["`vines hil data/scenes/elcentro_vines.toml --realtime` (1 kHz, host node), time-shared and with",
+               "`--realtime-priority 80 --cpus 0,1` (SCHED_FIFO 80 and locked memory for the bench and its node,",
+               "each on its own core), rounds interleaved, on an otherwise idle machine. A deadline is missed",
+               "when a sample's telemetry is not back within one sensor period of the sample's due time;",
+               "latency is from the sample's send to its telemetry. The service columns are what the OS",
+               "granted, read back from it.", ""]
+              + realtime_body(a.jsonl))
         print(f"figures.py: wrote {a.out}")
         return
     if a.what == "deadlines":

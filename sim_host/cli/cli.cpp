@@ -33,7 +33,7 @@ CLI::Option* add_accept_degraded(CLI::App& cmd, bool* accept) {
 namespace {
 
 // "a,b,c" -> *xs: every item a finite number > 0 (with whole: an integer from
-// lo to hi); else the reason, naming the list.
+// lo to hi, 0 too if lo is); else the reason, naming the list.
 std::string parse_list(const std::string& text, bool whole, double lo, double hi, std::vector<double>* xs) {
   xs->clear();
   for (std::size_t start = 0;;) {
@@ -41,8 +41,8 @@ std::string parse_list(const std::string& text, bool whole, double lo, double hi
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     char* end = nullptr;
     const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0))
-      return "not a list of positive numbers: " + text;
+    if (item.empty() || *end != '\0' || !std::isfinite(x) || (!whole && !(x > 0)))
+      return std::string(whole ? "not a list of integers: " : "not a list of positive numbers: ") + text;
     if (whole && (x != std::floor(x) || x < lo || x > hi)) {
       char range[64];
       std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);

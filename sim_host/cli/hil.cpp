@@ -202,6 +202,15 @@ void add_hil(CLI::App& vines) {
                   "sensor period): overruns reported")
       ->type_name("T")
       ->check(number_in(1, 4e9));
+  cmd->add_option("--realtime-priority", opt.rt_priority,
+                  "with --realtime: the bench and the host node at SCHED_FIFO priority N with their memory locked "
+                  "(mlockall); the report says what the OS granted and what it refused (privilege: root, "
+                  "CAP_SYS_NICE, or rtprio in /etc/security/limits.conf)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 99));
+  add_number_list(*cmd, "--cpus", &opt.cpus, 0, 1023,
+                  "with --realtime: the bench pinned to core B, the host node to core N")
+      ->type_name("B[,N]");
 
   const std::string faults = "fault options";
   for (int f = 0; f < host::kFaultKinds; ++f) {

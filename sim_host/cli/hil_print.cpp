@@ -81,6 +81,10 @@ void print_hil(const host::HilReport& r) {
   if (r.latency_us)
     std::printf(", latency mean %.0f us, p99 %.0f us, max %.0f us", r.latency_us->mean, r.latency_us->p99,
                 r.latency_us->max);
+  if (r.bench_service) {
+    std::printf("\n  real-time service: bench %s; node %s", host::describe(*r.bench_service).c_str(),
+                r.node_service ? host::describe(*r.node_service).c_str() : "elsewhere, its own (vines node --realtime-priority)");
+  }
   // Faults, by kind
   std::printf("\n  faults injected %lld, detected %lld, survived %lld; node restarts %lld\n", r.faults_injected,
               r.faults_detected, r.faults_survived, r.node_restarts);

@@ -6,6 +6,7 @@
 
 #include "sim_host/cli/cli.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/realtime.hpp"
 #include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 
@@ -16,12 +17,13 @@ void add_node(CLI::App& vines) {
     bool realtime = false;
     double idle_timeout_s = 30;
     std::string listen;
+    host::RealtimeRequest rt;
   };
   auto a = std::make_shared<NodeArgs>();
   CLI::App* cmd =
       add_command(vines, "node",
                   "The firmware node on stdin/stdout (what `vines hil` runs; protocol in docs/link_protocol.md).", "",
-                  [a] { return host::node_main(a->realtime, a->idle_timeout_s, a->listen); });
+                  [a] { return host::node_main(a->realtime, a->idle_timeout_s, a->listen, a->rt); });
   cmd->add_flag("--realtime", a->realtime, "deadlines on the local clock (default: the samples' stamps)");
   cmd->add_option("--idle-timeout", a->idle_timeout_s, "give up after S seconds without a byte (default 30)")
       ->type_name("S")
@@ -42,6 +44,11 @@ void add_node(CLI::App& vines) {
          "authentication, keep it on a lab network); PORT 0: a free one; or on a serial line, raw 8N1 (default "
          "3000000 baud), a fresh node for each bench's run; prints where it listens")
       ->type_name("tcp:[HOST:]PORT|serial:DEVICE[@BAUD]");
+  cmd->add_option("--realtime-priority", a->rt.priority,
+                  "SCHED_FIFO at priority N with the memory locked (what the OS refuses is said on stderr)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 99));
+  cmd->add_option("--cpu", a->rt.cpu, "pinned to core C")->type_name("C")->check(CLI::Range(0, 1023));
 }
 
 }  // namespace vines::cli

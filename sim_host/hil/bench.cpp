@@ -99,6 +99,10 @@ void choose_node(Bench* b) {
   } else if (o.node != "host") {
     throw std::runtime_error(refused);
   }
+  if ((o.rt_priority > 0 || !o.cpus.empty()) && !o.realtime)
+    throw std::runtime_error(std::string(o.rt_priority > 0 ? "--realtime-priority" : "--cpus") +
+                             ": real-time service is for a run on the wall clock: add --realtime");
+  if (o.cpus.size() > 2) throw std::runtime_error("--cpus: B[,N], the bench's core and the host node's");
   if (o.timeout_s <= 0) o.timeout_s = 5;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sim_host/hil/link/boards.hpp"
+#include "sim_host/hil/link/realtime.hpp"
 #include "sim_host/hil/options.hpp"
 #include "sim_host/hil/report.hpp"
 #include "sim_host/hil/watch.hpp"
@@ -29,6 +30,6 @@ HilReport run_hil(const Scene& scene, const HilOptions& opt, HilWatch* watch = n
 // listen ("tcp:[HOST:]PORT"), a node on TCP for one bench at a time, each
 // connection a fresh node, until killed (throws naming the address when it
 // cannot listen).
-int node_main(bool realtime, double idle_timeout_s, const std::string& listen = "");
+int node_main(bool realtime, double idle_timeout_s, const std::string& listen = "", const RealtimeRequest& rt = {});
 
 }  // namespace vines::host

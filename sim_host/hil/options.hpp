@@ -86,6 +86,13 @@ struct HilOptions {
   std::string node_command;       // host node: the program run as `PROGRAM node` ("" : this one)
   std::string image;              // qemu: the board image ("" : the preset build's)
   std::uint32_t budget_ticks = 0; // node's deadline budget in its counter ticks (0: one period)
+  // Real-time service (--realtime only): SCHED_FIFO at this priority and
+  // locked memory (0: none); the cores the bench and the host node are
+  // pinned to (none, the bench's, or both).
+  int rt_priority = 0;
+  std::vector<int> cpus;
+  int bench_cpu() const { return cpus.empty() ? -1 : cpus[0]; }
+  int node_cpu() const { return cpus.size() < 2 ? -1 : cpus[1]; }
 };
 
 }  // namespace vines::host

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "sim_host/hil/link/realtime.hpp"
 #include "vines/link/messages.hpp"
 
 namespace vines::host {
@@ -49,6 +50,9 @@ struct HilRecord {
   link::Status final_status;
   int node_exit = 0;
   double wall_s = 0;
+  // Real-time service asked for (--realtime-priority, --cpus): what the
+  // bench got, and the host node (none for a node elsewhere).
+  std::optional<RealtimeGrant> bench_service, node_service;
 
  private:
   std::size_t n() const { return static_cast<std::size_t>(samples); }

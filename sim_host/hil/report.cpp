@@ -171,6 +171,10 @@ json to_json(const HilReport& r) {
     j["median_step_instructions"] = r.board->median_step_instructions;
   }
   j["wall_time_s"] = r.wall_time_s;
+  if (r.bench_service) {
+    j["realtime_service"]["bench"] = to_json(*r.bench_service);
+    j["realtime_service"]["node"] = r.node_service ? to_json(*r.node_service) : nlohmann::json(nullptr);
+  }
   // The modes
   if (r.twin) j["twin"] = to_json(*r.twin);
   if (r.hybrid) j["hybrid"] = to_json(*r.hybrid);

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim_host/hil/link/realtime.hpp"
 #include "sim_host/hil/options.hpp"
 #include "sim_host/scene/scalar.hpp"
 #include "vines/link/messages.hpp"
@@ -176,6 +177,8 @@ struct HilReport {
   long long steps_over_budget = 0;  // from telemetry: equals the monitor's overruns on a clean run
   std::optional<HilBoardSteps> board;
   double wall_time_s = 0;
+  // Real-time service, when asked for: the bench's, the host node's
+  std::optional<RealtimeGrant> bench_service, node_service;
   // The modes' own results
   std::optional<HilTwinReport> twin;
   std::optional<HilHybridReport> hybrid;

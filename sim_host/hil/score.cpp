@@ -219,6 +219,8 @@ HilReport score(const Bench& b, const HilRecord& rec, const std::vector<Telemetr
   r.node_restarts = rec.restarts;
   r.bad_frames_from_node = rec.bad_frames;
   r.wall_time_s = rec.wall_s;
+  r.bench_service = rec.bench_service;
+  r.node_service = rec.node_service;
   score_faults(b, rec, offline, reference, events, &r);
   score_steps(b, rec, offline, &r);
   score_node(b, rec, &r);

@@ -33,6 +33,7 @@ class ChildProcess : public NodeTransport {
   // SIGKILL now (a firmware crash / power cut), and reap it.
   void kill_now() override;
   pid_t pid() const { return pid_; }
+  int process() const override { return pid_; }
 
  private:
   pid_t pid_ = -1;

@@ -21,6 +21,7 @@
 
 #include "firmware/app/node_app.hpp"
 #include "sim_host/hil/hil.hpp"
+#include "sim_host/hil/link/realtime.hpp"
 #include "sim_host/hil/link/serial.hpp"
 #include "sim_host/hil/link/tcp.hpp"
 #include "sim_host/hil/modes/plant.hpp"
@@ -84,7 +85,11 @@ int serve_serial(bool realtime, double idle_timeout_s, const std::string& listen
 
 }  // namespace
 
-int node_main(bool realtime, double idle_timeout_s, const std::string& listen) {
+int node_main(bool realtime, double idle_timeout_s, const std::string& listen, const RealtimeRequest& rt) {
+  // Real-time service first, before the node's memory is touched; what the
+  // OS refused is said, and the bench reads what was granted from /proc.
+  if (rt.any())
+    for (const std::string& r : ask_realtime(rt).refused) std::fprintf(stderr, "vines node: refused: %s\n", r.c_str());
   if (listen.empty()) return serve_link(realtime, idle_timeout_s);
   if (is_serial(listen)) return serve_serial(realtime, idle_timeout_s, listen);
   const TcpAddress a = parse_tcp_address(listen, "127.0.0.1", true);

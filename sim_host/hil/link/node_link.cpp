@@ -30,6 +30,8 @@ std::vector<std::string> NodeLink::argv(const HilOptions& opt) {
   if (!opt.image.empty() && opt.node.rfind("qemu:", 0) == 0) return qemu_argv(*board_of(opt.node), opt.image);
   std::vector<std::string> a = {opt.node_command.empty() ? self_exe() : opt.node_command, "node"};
   if (opt.realtime) a.push_back("--realtime");
+  if (opt.rt_priority > 0) a.insert(a.end(), {"--realtime-priority", std::to_string(opt.rt_priority)});
+  if (opt.node_cpu() >= 0) a.insert(a.end(), {"--cpu", std::to_string(opt.node_cpu())});
   return a;
 }
 

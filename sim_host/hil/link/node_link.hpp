@@ -62,6 +62,7 @@ class NodeLink {
   long long bad_frames() const { return bad_frames_; }
   long long statuses() const { return statuses_; }  // status messages received
   const std::string& name() const { return name_; }
+  int process() const { return link_->process(); }  // the node's process here, or -1
   void set_epoch(HilClock::time_point t0) { t0_ = t0; }
   // Kills the node, then reads what it had sent.
   void kill();

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "sim_host/hil/link/node_link.hpp"
+#include "sim_host/hil/link/realtime.hpp"
 
 namespace vines::host {
 namespace {
@@ -31,9 +32,15 @@ class Stream {
   }
 
   HilRecord run() {
+    // Real-time service for the bench while it runs, and what the host node
+    // (asked on its command line) got.
+    const RealtimeRequest bench_rt{o_.rt_priority, o_.bench_cpu()}, node_rt{o_.rt_priority, o_.node_cpu()};
+    const RealtimeScope rt(bench_rt);
+    if (bench_rt.any() || node_rt.any()) rec_.bench_service = rt.grant();
     t0_ = HilClock::now();
     node_ = new_node();
     configure(*node_, b_.cfg, b_.image);
+    if ((bench_rt.any() || node_rt.any()) && node_->process() > 0) rec_.node_service = realtime_of(node_->process(), node_rt);
     t0_ = HilClock::now();  // the bench clock starts with the run
     node_->set_epoch(t0_);
     start(*node_, 0, 0);

@@ -25,6 +25,8 @@ class NodeTransport {
   virtual int finish(double timeout_s) = 0;
   // Cuts the node off now (a power cut): a process killed, a connection reset.
   virtual void kill_now() = 0;
+  // The node's process on this machine (a child), or -1 (TCP, a serial line).
+  virtual int process() const { return -1; }
 };
 
 }  // namespace vines::host
