@@ -34,7 +34,7 @@ void write_all_fd(int fd, const std::uint8_t* p, std::size_t n, double timeout_s
   }
 }
 
-bool read_some_fd(int* fd, std::vector<std::uint8_t>* out, double timeout_s) {
+bool read_some_fd(int* fd, std::vector<std::uint8_t>* out, double timeout_s, bool terminal) {
   if (*fd < 0) return false;
   pollfd pf{*fd, POLLIN, 0};
   const double t = std::max(0.0, std::min(timeout_s, 1e6));
@@ -49,6 +49,7 @@ bool read_some_fd(int* fd, std::vector<std::uint8_t>* out, double timeout_s) {
       continue;
     }
     if (n < 0 && (errno == EAGAIN || errno == EINTR)) return true;
+    if (n == 0 && terminal && !(pf.revents & (POLLHUP | POLLERR))) return true;
     ::close(*fd);
     *fd = -1;
     return false;

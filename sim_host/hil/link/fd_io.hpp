@@ -13,8 +13,10 @@ namespace vines::host {
 void write_all_fd(int fd, const std::uint8_t* p, std::size_t n, double timeout_s);
 
 // Appends what arrives within timeout_s (0: do not wait) to out; at the end
-// of input (or an error) closes *fd, sets it to -1 and returns false.
-bool read_some_fd(int* fd, std::vector<std::uint8_t>* out, double timeout_s);
+// of input (or an error) closes *fd, sets it to -1 and returns false. A
+// terminal in raw mode reads 0 bytes when none have come: with terminal, the
+// end is its hang-up or an error (a board unplugged: EIO), not a 0.
+bool read_some_fd(int* fd, std::vector<std::uint8_t>* out, double timeout_s, bool terminal = false);
 
 // Milliseconds for poll(): s rounded up, 0 for s <= 0.
 int poll_ms(double s);

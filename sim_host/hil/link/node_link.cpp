@@ -58,12 +58,15 @@ void NodeLink::pump(double timeout_s) {
   // A node ends after answering STOP; before that, an exit is a failure.
   if (!open && acked_ < delimiters_) {
     const std::string unanswered = " with " + std::to_string(delimiters_ - acked_) + " frames unanswered";
-    if (is_tcp(name_) || is_serial(name_))
-      throw std::runtime_error("node " + name_ + ": the " + (is_tcp(name_) ? "connection" : "line") + " ended" +
-                               unanswered);
-    throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) + ")" +
-                             unanswered);
+    throw gone(unanswered);
   }
+}
+
+// The node is gone: its connection or line ended, or its process exited.
+std::runtime_error NodeLink::gone(const std::string& tail) {
+  if (is_tcp(name_) || is_serial(name_))
+    return std::runtime_error("node " + name_ + ": the " + (is_tcp(name_) ? "connection" : "line") + " ended" + tail);
+  return std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) + ")" + tail);
 }
 
 void NodeLink::kill() {
@@ -123,11 +126,7 @@ void NodeLink::await_announce() {
     if (left <= 0)
       throw std::runtime_error("node " + name_ + ": no answer within " + std::to_string(opt_.timeout_s) +
                                " s: it did not say it listens (--timeout)");
-    if (!read(std::min(left, 0.05)) && statuses_ == 0) {
-      if (is_tcp(name_)) throw std::runtime_error("node " + name_ + ": the connection ended before it said it listens");
-      throw std::runtime_error("node " + name_ + " exited (status " + std::to_string(link_->finish(1)) +
-                               ") before it said it listens");
-    }
+    if (!read(std::min(left, 0.05)) && statuses_ == 0) throw gone(" before it said it listens");
   }
 }
 

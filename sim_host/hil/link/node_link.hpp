@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,7 @@ class NodeLink {
   static std::unique_ptr<NodeTransport> open(const HilOptions& opt);
   // Reads and dispatches what came within timeout_s; false once the pipe ended.
   bool read(double timeout_s);
+  std::runtime_error gone(const std::string& tail);
 
   const HilOptions& opt_;
   long long life_;

@@ -1,7 +1,6 @@
 #include "sim_host/hil/link/serial.hpp"
 
 #include <fcntl.h>
-#include <poll.h>
 #include <sys/file.h>
 #include <termios.h>
 #include <unistd.h>
@@ -126,26 +125,8 @@ void SerialNode::write_all(const std::uint8_t* p, std::size_t n, double timeout_
   write_all_fd(fd_, p, n, timeout_s);
 }
 
-// A terminal in raw mode reads 0 bytes when none have come (not the end of
-// input, as on a pipe); the line is gone when it hangs up or fails (a board
-// unplugged: EIO).
 bool SerialNode::read_some(std::vector<std::uint8_t>* out, double timeout_s) {
-  if (fd_ < 0) return false;
-  pollfd pf{fd_, POLLIN, 0};
-  const int r = ::poll(&pf, 1, poll_ms(timeout_s));
-  if (r <= 0) return true;
-  std::uint8_t buf[8192];
-  for (;;) {
-    const ssize_t n = ::read(fd_, buf, sizeof buf);
-    if (n > 0) {
-      out->insert(out->end(), buf, buf + n);
-      continue;
-    }
-    if (n == 0 && !(pf.revents & (POLLHUP | POLLERR))) return true;
-    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return true;
-    kill_now();
-    return false;
-  }
+  return read_some_fd(&fd_, out, timeout_s, true);
 }
 
 int SerialNode::finish(double) {
