@@ -47,12 +47,14 @@ struct Line {
   bool up() const { return exists(node_end) && exists(bench_end); }
 };
 
-// `vines node --listen serial:END@4000000`, once it says it listens.
+// `vines node --listen serial:END@4000000` (or its other spelling, `--serial
+// END@4000000`), once it says it listens.
 struct SerialListener {
   ChildProcess node;
   bool listening = false;
-  explicit SerialListener(const Line& line)
-      : node({VINES_EXE, "node", "--listen", "serial:" + line.node_end + "@4000000"}) {
+  explicit SerialListener(const Line& line, bool serial_option = false)
+      : node({VINES_EXE, "node", serial_option ? "--serial" : "--listen",
+              (serial_option ? "" : "serial:") + line.node_end + "@4000000"}) {
     std::vector<std::uint8_t> out;
     for (int i = 0; i < 100 && !listening; ++i) {
       node.read_some(&out, 0.1);
@@ -123,7 +125,7 @@ TEST(HilSerial, ANodeThatIsNotThereOrALineThatBreaksIsNamed) {
   // bench stops naming it, and writes no CSV rather than part of one.
   Line line2("vines_serial_cut");
   ASSERT_TRUE(line2.up());
-  SerialListener l(line2);
+  SerialListener l(line2, true);
   ASSERT_TRUE(l.listening);
   o = base(3.0);
   o.node = "serial:" + line2.bench_end + "@4000000";

@@ -44,6 +44,19 @@ void add_node(CLI::App& vines) {
          "authentication, keep it on a lab network); PORT 0: a free one; or on a serial line, raw 8N1 (default "
          "3000000 baud), a fresh node for each bench's run; prints where it listens")
       ->type_name("tcp:[HOST:]PORT|serial:DEVICE[@BAUD]");
+  CLI::Option* serial = cmd->add_option_function<std::string>(
+                               "--serial",
+                               [a](const std::string& v) {
+                                 try {
+                                   host::parse_serial_address("serial:" + v);
+                                 } catch (const std::runtime_error& e) {
+                                   throw CLI::ValidationError("--serial", e.what());
+                                 }
+                                 a->listen = "serial:" + v;
+                               },
+                               "the same as --listen serial:DEVICE[@BAUD]")
+                            ->type_name("DEVICE[@BAUD]");
+  serial->excludes(cmd->get_option("--listen"));
   cmd->add_option("--realtime-priority", a->rt.priority,
                   "SCHED_FIFO at priority N with the memory locked (what the OS refuses is said on stderr)")
       ->type_name("N")
