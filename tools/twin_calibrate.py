@@ -28,7 +28,8 @@ from twin_benchmark import scene_text  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ALONE = {"absolute": ["--twin-threshold-change", "1e6", "--twin-threshold", "1e6", "--twin-suspect", "1e6"],
-         "change": ["--twin-threshold", "1e6", "--twin-threshold-change", "1e-9", "--twin-suspect", "1e6"]}
+         "change": ["--twin-threshold", "1e6", "--twin-threshold-change", "1e-9", "--twin-suspect", "1e6",
+                    "--twin-healthy-tolerance", "1e3", "--twin-mass-tolerance", "1e3"]}
 HOLD_UPDATES = 40  # 2 s of 50 ms updates
 
 

@@ -218,6 +218,7 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kThreshold] = t.threshold;
   set[twin::kThresholdChange] = t.threshold_change;
   set[twin::kTwoStory] = t.two_story;
+  set[twin::kTwoShare] = t.two_story_share;
   set[twin::kSeparation] = t.separation;
   set[twin::kInflation] = t.inflation;
   set[twin::kDriftVar] = t.drift_sd * t.drift_sd;
@@ -226,6 +227,8 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kRestartSteps] = std::round(t.restart_gap_s / h);
   set[twin::kRestartKeep] = std::min(1.0, t.restart_keep);
   set[twin::kScoreForget] = std::exp(-set[twin::kUpdateSteps] * h / t.score_window_s);
+  set[twin::kCalmSteps] = std::round(t.calm_s / h);
+  set[twin::kBeforeVarMax] = t.before_sd_max * t.before_sd_max;
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);
   set[twin::kInnovAlpha] = std::min(1.0, h / t.innov_window_s);

@@ -37,12 +37,15 @@ struct TwinTuning {
   // (healthy stories within 3 % of the drawing, masses within 2 %, each
   // uniform).
   double threshold = 12;         // absolute test
-  double threshold_change = 25;  // change tests
+  double threshold_change = 28;  // change tests
   double two_story = 10.8;       // a pair beyond the best story by this (chi-square 1 dof, 0.1 %)
+  double two_story_share = 0.1;  // ...and by this share of the best story's statistic
   double separation = 4;         // a story named beyond the next by this
   double inflation = 1;          // the estimate's covariance times this
-  double drift_sd = 0.01;        // a change test's model drift per story
-  double snapshot_s = 1.0;       // the change tests' snapshots
+  double drift_sd = 0.002;       // a change test's model drift per story
+  double snapshot_s = 1.0;       // the change tests' snapshots: the candidate onsets
+  double calm_s = 0.4;           // a change test leaves out this long after each impact (VI NES)
+  double before_sd_max = 0.02;   // a candidate onset: every story's fit before it within this sd
   double score_window_s = 2;     // the score's memory
   double suspect = 60;           // the score statistic beyond this restarts the information...
   double restart_gap_s = 10;     // ...at most once in this long...

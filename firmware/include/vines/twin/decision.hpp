@@ -7,20 +7,23 @@
 // their error:
 // - absolute: the losses less the baseline's (the factors a commissioning
 //   run on the healthy building identified; none: nominal), with the error
-//   the estimate's own (its information, times an inflation factor, 1 by
-//   calibration) plus the model's (the baseline's
-//   covariance, or the healthy stories' and masses' spread about the
-//   drawing);
-// - change: the losses now less the losses some seconds ago (a ring of
-//   snapshots, one a second), so that the model's error, the same before and
-//   after, cancels (a damage that strikes during the record); the error the
-//   two estimates' plus a small drift.
+//   the estimate's own (its information, times an inflation factor) plus the
+//   model's (the baseline's covariance, or the healthy stories' and masses'
+//   spread about the drawing);
+// - change at an onset (a damage that strikes during the record): the
+//   building identified from the data before a candidate onset against the
+//   building identified from the data after it, each a least-squares fit of
+//   its own window (the estimator's linearised information and right-hand
+//   side, summed since the start and snapshotted once a second), so that the
+//   model's error, the same before and after, cancels; the error the two
+//   windows' plus a small drift. Every snapshot of the ring is a candidate
+//   onset, scanned in turn (Willsky and Jones' generalised likelihood ratio
+//   for a jump at an unknown time); the best candidate dates the onset.
 // A test names a story when its statistic beats the threshold and the next
 // story's by the separation ("damage, story not identified" otherwise), two
 // stories when the pair beats the best one by the two-story margin. A
-// candidate held for the hold time raises the alarm, which latches. The onset
-// is where the estimator's change score last rose, or else where the named
-// story's change began in the snapshots.
+// candidate held for the hold time raises the alarm, which latches; the
+// verdict is the last candidate held (a change test's: the strongest).
 #pragma once
 
 #include <cmath>
@@ -34,40 +37,52 @@ template <typename S>
 struct DecisionSettings {
   S threshold = S(0);         // one-story statistic for an absolute candidate
   S threshold_change = S(0);  // ...for a change candidate
-  S two = S(0);               // two stories: the pair's statistic beyond the best story's by this
+  S two = S(0);               // two stories: the pair's statistic beyond the best story's by this...
+  S two_share = S(0);         // ...and by this share of it (a large loss's misfit grows with it)
   S separation = S(0);        // a story named: its statistic beyond the next story's by this
   S inflation = S(1);         // the estimate's covariance times this
   S drift_var = S(0);         // a change test's model drift, variance per story
   long snap_steps = 1;        // steps between snapshots
   long hold_steps = 0;        // a candidate held this long raises the alarm
   long restart_steps = 0;     // the estimator restarts at most once in this many steps
+  S before_var_max = S(1);    // a candidate onset: every story's fit before it within this variance
 };
+
+// A symmetric matrix of the parameters (the stories and the device's), its
+// lower triangle packed row by row.
+inline constexpr int tri(int a, int b) { return a * (a + 1) / 2 + b; }  // a >= b
 
 template <typename S, int N>
 class Decision {
  public:
-  static constexpr int kRing = 64;                 // snapshots kept (seconds at one a second)
-  static constexpr int kLags = 5;                  // change tests, against snapshots this far back:
-  static constexpr int kLag[kLags] = {4, 8, 16, 32, 63};
+  static constexpr int kP = N + 1;                // parameters at most: the stories and the device's
+  static constexpr int kTri = kP * (kP + 1) / 2;  // a packed kP x kP
+  static constexpr int kRing = 24;                // snapshots kept, one a second (the M7 double image in 64 KB)
+  static constexpr int kMinAfter = 2;             // a change's window after its onset: at least this many snapshots
 
-  // base: the baseline's losses (n); sigma0: the model's covariance (n x n).
-  void init(int n, const DecisionSettings<S>& s, const S* base, const S (*sigma0)[N]) {
-    n_ = n, set_ = s, base_ = base, sigma0_ = sigma0;
-    count_ = 0, head_ = 0, lag_turn_ = 0, held_ = 0, since_restart_ = s.restart_steps;
+  // n stories of np parameters; base: the baseline's losses (n); sigma0: the
+  // model's covariance (n x n); prior: each parameter's prior information.
+  void init(int n, int np, const DecisionSettings<S>& s, const S* base, const S (*sigma0)[N], const S* prior) {
+    n_ = n, np_ = np, set_ = s, base_ = base, sigma0_ = sigma0, prior_ = prior;
+    count_ = 0, head_ = 0, held_ = 0, since_restart_ = s.restart_steps;
     restart_ = false, suspected_ = false, now_ = 0, rise_ = -1;
     detected_ = false, story_ = -1, second_ = -1, onset_ = -1;
     size_ = size2_ = S(0);
-    for (auto& l : lag_) l.valid = false;
-    abs_.valid = false;
+    abs_.valid = scan_.valid = last_.valid = cand_.valid = false;
+    back_ = kMinAfter, phase_ = 0;
     for (int j = 0; j < N; ++j) evidence_[j] = S(0);
+    lead_thr_ = s.threshold, reported_margin_ = S(0), reported_change_ = false;
   }
 
-  // Every step k: a snapshot of the losses every snap_steps.
-  void observe(long k, const S* loss, S sdmax) {
+  // Every step k: a snapshot every snap_steps of the losses and of the
+  // change information so far (J packed, b: twin/estimator.hpp).
+  void observe(long k, const S* loss, const S* J, const S* b) {
     if (k % set_.snap_steps != 0) return;
     Snap& s = ring_[head_];
     for (int j = 0; j < n_; ++j) s.loss[j] = loss[j];
-    s.sdmax = sdmax, s.k = k;
+    for (int i = 0; i < tri(np_ - 1, np_ - 1) + 1; ++i) s.J[i] = J[i];
+    for (int a = 0; a < np_; ++a) s.b[a] = b[a];
+    s.k = k;
     head_ = (head_ + 1) % kRing;
     if (count_ < kRing) ++count_;
   }
@@ -79,65 +94,99 @@ class Decision {
       th[a] = loss[a] - base_[a];
       for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * sig[a][b] + sigma0_[a][b];
     }
-    run(A, th, -1, &abs_);
+    run(A, th, &abs_);
+    abs_.onset_k = -1;
   }
 
-  // The next change test in turn: the losses now against the snapshot its
-  // lag back, if there is one.
-  void change(const S* loss, const S (&sig)[N][N], S sdmax) {
-    const int i = lag_turn_;
-    lag_turn_ = (lag_turn_ + 1) % kLags;
-    Test& t = lag_[i];
-    t.valid = false;
-    if (kLag[i] >= count_) return;
-    const int r = (head_ - 1 - kLag[i] + 2 * kRing) % kRing;
-    const Snap& ref = ring_[r];
-    const S rho = sdmax > S(0) ? (ref.sdmax / sdmax) * (ref.sdmax / sdmax) : S(1);
+  // One part of the change scan, on the information so far (J, b): a
+  // candidate onset's window before it, its window after it, their test.
+  // Candidates go from the newest snapshot kMinAfter back to the oldest;
+  // the best of a whole scan is kept until the next scan ends.
+  void scan(const S* J, const S* b) {
+    if (count_ <= kMinAfter) return;
+    if (phase_ == 0) {
+      if (back_ >= count_) {  // the scan is over
+        last_ = scan_, scan_.valid = false, back_ = kMinAfter;
+        return;
+      }
+      ref_ = (head_ - 1 - back_ + 2 * kRing) % kRing;
+      ref_k_ = ring_[ref_].k;
+      // A window before that is no reference yet (the prior, a record's
+      // first seconds) ends the scan: the older ones know less still.
+      phase_ = fit(ring_[ref_].J, nullptr, ring_[ref_].b, nullptr, nullptr, before_, P1_) ? 1 : 0;
+      for (int a = 0; a < n_ && phase_ == 1; ++a)
+        if (P1_[a][a] > set_.before_var_max) phase_ = 0;
+      if (phase_ == 0) back_ = count_;
+      return;
+    }
+    const Snap& r = ring_[ref_];
+    if (r.k != ref_k_) {  // overwritten by a newer snapshot meanwhile
+      phase_ = 0, ++back_;
+      return;
+    }
+    if (phase_ == 1) {
+      phase_ = fit(J, r.J, b, r.b, before_, after_, P2_) ? 2 : 0;
+      if (phase_ == 0) ++back_;
+      return;
+    }
     S A[N][N], th[N] = {};
     for (int a = 0; a < n_; ++a) {
-      th[a] = loss[a] - ref.loss[a];
-      for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * (S(1) + rho) * sig[a][b] + (a == b ? set_.drift_var : S(0));
+      th[a] = after_[a] - before_[a];
+      for (int c = 0; c <= a; ++c)
+        A[a][c] = set_.inflation * (P1_[a][c] + P2_[a][c]) + (a == c ? set_.drift_var : S(0));
     }
-    run(A, th, r, &t);
+    run(A, th, &cand_);
+    cand_.onset_k = r.k;
+    if (cand_.valid && cand_.h.story >= 0 && (!scan_.valid || cand_.h.one > scan_.h.one)) scan_ = cand_;
+    phase_ = 0, ++back_;
   }
 
   // After the tests: the strongest candidate, held, latched; its story (or
   // none identified), size, second story and onset. elapsed: steps since the
   // last decide().
   void decide(long elapsed, bool suspected = false) {
-    const Test* best = nullptr;
-    S best_margin(0);
+    // The leading test: the one whose best story comes nearest its
+    // threshold (or beats it by most); a candidate if it beats it.
+    const Test* lead = nullptr;
+    S lead_margin(0);
     auto consider = [&](const Test& t, S thr) {
       if (!t.valid || t.h.story < 0) return;
       const S margin = t.h.one - thr;
-      if (margin > S(0) && (best == nullptr || margin > best_margin)) best = &t, best_margin = margin;
+      if (lead == nullptr || margin > lead_margin) lead = &t, lead_margin = margin, lead_thr_ = thr;
     };
     consider(abs_, set_.threshold);
-    for (const Test& t : lag_) consider(t, set_.threshold_change);
-    const Test& shown = best ? *best : abs_;
-    for (int j = 0; j < n_; ++j) evidence_[j] = shown.valid ? shown.h.stat[j] : S(0);
+    consider(last_, set_.threshold_change);
+    consider(scan_, set_.threshold_change);
+    for (int j = 0; j < n_; ++j) evidence_[j] = lead ? lead->h.stat[j] : S(0);
+    const Test* best = lead && lead_margin > S(0) ? lead : nullptr;
     held_ = best ? held_ + elapsed : 0;
     // A change suspected (the estimator's score): it restarts its
     // information, so that it follows the changed building rather than a
     // compromise between the building before and after (section 5).
     since_restart_ += elapsed;
     now_ += elapsed;
-    if (suspected && !suspected_) rise_ = now_;  // where the score rose: the change's onset
+    if (suspected && !suspected_) rise_ = now_;  // where the score rose
     suspected_ = suspected;
     if (suspected && since_restart_ >= set_.restart_steps && !detected_) restart_ = true, since_restart_ = 0;
+    // The verdict: the last candidate held, but for a change test's weaker
+    // than the change test's it stands for (its evidence grows with the data
+    // after its onset, until the onset leaves the snapshots' span and only
+    // later, weaker candidates remain).
     if (!best || held_ < set_.hold_steps) return;
-    detected_ = true;
+    if (detected_ && best->onset_k >= 0 && reported_change_ && lead_margin < reported_margin_) return;
+    detected_ = true, reported_margin_ = lead_margin, reported_change_ = best->onset_k >= 0;
     const Hypotheses<S, N>& h = best->h;
-    if (h.two - h.one > set_.two) {
+    if (h.two - h.one > set_.two + set_.two_share * h.one) {
       story_ = h.a, second_ = h.b, size_ = h.size_a, size2_ = h.size_b;
     } else {
       story_ = h.one - h.runner > set_.separation ? h.story : -1;
       second_ = -1, size_ = h.size[h.story], size2_ = S(0);
     }
-    // The onset: where the score last rose, if it did within the snapshots'
-    // span; else where the named story's change began in them.
+    // The onset: a change test's candidate; for the absolute test, where the
+    // score last rose, if it did within the snapshots' span, else where the
+    // named story's loss began in them.
     const bool risen = rise_ >= 0 && now_ - rise_ <= static_cast<long>(kRing) * set_.snap_steps;
-    onset_ = risen ? rise_ : onset(*best, h.story);
+    onset_ = best->onset_k >= 0 ? best->onset_k : risen ? rise_ : onset(h.story);
   }
 
   // Whether the estimator should restart its information now (once per
@@ -156,67 +205,87 @@ class Decision {
   S second_size() const { return size2_; }
   long onset_step() const { return onset_; }                 // -1: none
   S evidence(int j) const { return evidence_[j]; }           // story j's statistic in the leading test
-  S threshold() const { return set_.threshold; }
+  S threshold() const { return lead_thr_; }                  // the leading test's threshold
 
  private:
   struct Snap {
     S loss[N] = {};
-    S sdmax = S(0);
-    long k = 0;
+    S J[kTri] = {}, b[kP] = {};
+    long k = -1;
   };
   struct Test {
     bool valid = false;
-    int ref = -1;    // the snapshot it is against (-1: the baseline)
-    S row[N] = {};   // its best story's row of the precision
+    long onset_k = -1;  // a change test's onset candidate (-1: the absolute test)
+    S row[N] = {};      // its best story's row of the precision
     Hypotheses<S, N> h;
   };
 
-  void run(S (&A)[N][N], const S* th, int ref, Test* t) {
+  void run(S (&A)[N][N], const S* th, Test* t) const {
     t->valid = false;
     if (!cholesky(A, n_)) return;
     S P[N][N];
     inverse_from_factor(A, n_, P);
     test_hypotheses(P, th, n_, &t->h);
-    t->ref = ref;
     if (t->h.story >= 0)
       for (int b = 0; b < n_; ++b) t->row[b] = P[t->h.story][b];
     t->valid = true;
   }
 
-  // Story j's size in snapshot s, as the test sees it (its precision's row).
-  S projected(const Test& t, int j, const Snap& s) const {
-    const Snap* ref = t.ref >= 0 ? &ring_[t.ref] : nullptr;
-    S u(0);
-    for (int b = 0; b < n_; ++b) u += t.row[b] * (s.loss[b] - (ref ? ref->loss[b] : base_[b]));
-    return u / t.row[j];
+  // One window's fit: information J less J0 (if given) plus the prior, right
+  // side b less b0 plus the prior times pull (the window before: a short
+  // window after an onset leans on it, not on the drawing); the parameters
+  // theta and the stories' block of their covariance.
+  bool fit(const S* J, const S* J0, const S* b, const S* b0, const S* pull, S (&theta)[kP], S (&P)[N][N]) const {
+    S F[kP][kP];
+    for (int a = 0; a < np_; ++a)
+      for (int c = 0; c <= a; ++c) F[a][c] = J[tri(a, c)] - (J0 ? J0[tri(a, c)] : S(0)) + (a == c ? prior_[a] : S(0));
+    if (!cholesky(F, np_)) return false;
+    for (int a = 0; a < np_; ++a) theta[a] = b[a] - (b0 ? b0[a] : S(0)) + (pull ? prior_[a] * pull[a] : S(0));
+    solve_from_factor(F, np_, theta);
+    S Q[kP][kP];
+    inverse_from_factor(F, np_, Q);
+    for (int a = 0; a < n_; ++a)
+      for (int c = 0; c < n_; ++c) P[a][c] = Q[a][c];
+    return true;
   }
 
-  // The onset: between the last snapshot (from the test's reference on)
-  // where story j's size was under a quarter of its size now, and the next.
-  long onset(const Test& t, int j) const {
+  // The absolute test's onset: between the last snapshot where story j's
+  // size, as the test projects it, was under a quarter of its size now, and
+  // the next.
+  S projected(int j, const Snap& s) const {
+    S u(0);
+    for (int b = 0; b < n_; ++b) u += abs_.row[b] * (s.loss[b] - base_[b]);
+    return u / abs_.row[j];
+  }
+  long onset(int j) const {
     if (j < 0 || count_ == 0) return -1;
     const int newest = (head_ - 1 + kRing) % kRing;
-    const S now = projected(t, j, ring_[newest]);
-    const int span = t.ref >= 0 ? (newest - t.ref + kRing) % kRing : count_ - 1;
-    for (int back = 1; back <= span; ++back) {
+    const S now = projected(j, ring_[newest]);
+    for (int back = 1; back < count_; ++back) {
       const int i = (newest - back + kRing) % kRing;
-      if (projected(t, j, ring_[i]) <= S(0.25) * now) return (ring_[i].k + ring_[(i + 1) % kRing].k) / 2;
+      if (projected(j, ring_[i]) <= S(0.25) * now) return (ring_[i].k + ring_[(i + 1) % kRing].k) / 2;
     }
-    return ring_[(newest - span + kRing) % kRing].k;
+    return ring_[(newest - count_ + 1 + kRing) % kRing].k;
   }
 
-  int n_ = 0;
+  int n_ = 0, np_ = 0;
   DecisionSettings<S> set_;
   const S* base_ = nullptr;
   const S (*sigma0_)[N] = nullptr;
+  const S* prior_ = nullptr;
   Snap ring_[kRing];
-  int count_ = 0, head_ = 0, lag_turn_ = 0;
-  Test abs_, lag_[kLags];
+  int count_ = 0, head_ = 0;
+  // The absolute test; the change scan's best so far, the last whole scan's
+  // best, the candidate in hand.
+  Test abs_, scan_, last_, cand_;
+  int back_ = kMinAfter, phase_ = 0, ref_ = 0;
+  long ref_k_ = -1;
+  S before_[kP] = {}, after_[kP] = {}, P1_[N][N] = {}, P2_[N][N] = {};
   long held_ = 0, onset_ = -1, since_restart_ = 0, now_ = 0, rise_ = -1;
-  bool detected_ = false, restart_ = false, suspected_ = false;
+  bool detected_ = false, restart_ = false, suspected_ = false, reported_change_ = false;
   int story_ = -1, second_ = -1;
   S size_ = S(0), size2_ = S(0);
-  S evidence_[N] = {};
+  S evidence_[N] = {}, lead_thr_ = S(0), reported_margin_ = S(0);
 };
 
 }  // namespace vines::twin

@@ -39,7 +39,9 @@ class Estimator : public ImageDecoder<S, N> {
       loss_[j] = S(0), g_[j] = S(0), sd_[j] = S(0), held_[j] = 0;
       for (int i = 0; i < kX; ++i) s_[j][i] = S(0);
       for (int i = 0; i < kP; ++i) J_[j][i] = S(0);
+      bc_[j] = S(0);
     }
+    for (S& v : Jc_) v = S(0);
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
     since_ = 0, k_ = 0, phase_ = 0, score_ = S(0);
     lam_update_ = static_cast<S>(std::pow(set_[kForget], static_cast<double>(update_steps_)));
@@ -47,21 +49,21 @@ class Estimator : public ImageDecoder<S, N> {
       Gs_[a] = S(0);
       for (int b = 0; b < kP; ++b) J0_[a][b] = Is_[a][b] = S(0);
     }
-    impact_left_ = 0;
+    impact_left_ = 0, calm_ = 0;
     device_alarm_ = false;
     factored_ = false;
     a_ = a0;
-    dec_.init(d_.stories, decision_settings(), base_, sigma0_);
+    dec_.init(d_.stories, d_.np, decision_settings(), base_, sigma0_, prior_);
     update(y, ny);
     refresh_sd();
-    dec_.observe(k_, loss_, sd_max());
+    dec_.observe(k_, loss_, Jc_, bc_);
   }
 
   // One sensor period to ground acceleration a1, then the measurements y.
   void step(S a1, const double* y, int ny) {
     predict(a1);
     update(y, ny);
-    dec_.observe(++k_, loss_, sd_max());
+    dec_.observe(++k_, loss_, Jc_, bc_);
     if (++since_ >= update_steps_) {
       since_ = 0;
       solve();
@@ -69,6 +71,8 @@ class Estimator : public ImageDecoder<S, N> {
       phase_ = 1;
     } else if (phase_ > 0) {
       decision_phase();
+    } else {
+      dec_.scan(Jc_, bc_);
     }
   }
 
@@ -165,6 +169,8 @@ class Estimator : public ImageDecoder<S, N> {
     // innovation jumps beyond kJumpSigma of its quiet sd, then the impact
     // one (the force free) for kJumpHold steps.
     if (impact) impact_left_ = static_cast<long>(set_[kJumpHold]);
+    calm_ = impact_left_ > 0 ? 0 : calm_ + 1;
+    const bool explained = d_.extra != TwinExtra::kForce || calm_ > static_cast<long>(set_[kCalmSteps]);
     const S(*L)[kY] = impact_left_ > 0 ? L_ : Lq_;
     if (impact_left_ > 0) --impact_left_;
     for (int r = 0; r < nx; ++r) z_[r] += dot(L[r], eps_, ny);
@@ -188,6 +194,20 @@ class Estimator : public ImageDecoder<S, N> {
         const S pa = wt * psi[i][a];
         g_[a] += pa * eps_[i];
         for (int b = 0; b <= a; ++b) J_[a][b] += pa * psi[i][b];
+      }
+      if (!explained) continue;
+      // The change tests' information, summed since the start without
+      // forgetting: a least-squares fit of any window of it is J^-1 b, the
+      // innovation linearised about the estimate of its step (eps less
+      // psi (theta - loss)), so that each window's fit is its own whatever
+      // the estimate did meanwhile. Impacts' samples left out: the frame's
+      // model does not explain them.
+      S yl = eps_[i];
+      for (int a = 0; a < np; ++a) yl += psi[i][a] * loss_[a];
+      for (int a = 0; a < np; ++a) {
+        const S pa = wt * psi[i][a];
+        bc_[a] += pa * yl;
+        for (int b = 0; b <= a; ++b) Jc_[tri(a, b)] += pa * psi[i][b];
       }
     }
   }
@@ -215,16 +235,8 @@ class Estimator : public ImageDecoder<S, N> {
     if (!factored_) return;
     const S(&F)[kP][kP] = F_;
     S u[kP];
-    for (int a = 0; a < np; ++a) {
-      S t = g_[a];
-      for (int c = 0; c < a; ++c) t -= F[a][c] * u[c];
-      u[a] = t / F[a][a];
-    }
-    for (int a = np - 1; a >= 0; --a) {
-      S t = u[a];
-      for (int c = a + 1; c < np; ++c) t -= F[c][a] * u[c];
-      u[a] = t / F[a][a];
-    }
+    for (int a = 0; a < np; ++a) u[a] = g_[a];
+    solve_from_factor(F, np, u);
     // A trust region: no parameter moves by more than its cap an update (the
     // sensitivities are a linearisation; a long step on little information
     // lands where they no longer hold).
@@ -283,7 +295,8 @@ class Estimator : public ImageDecoder<S, N> {
   // The stories' decision (twin/decision.hpp), one part a step after an
   // update so that no step carries it all: the estimate's covariance of the
   // stories (the stories' block of (J + prior)^-1: the device's parameter
-  // marginalised), the absolute test, one change test, the verdict.
+  // marginalised), the absolute test, the verdict. The change scan takes
+  // the other steps between updates.
   void decision_phase() {
     const int n = d_.stories;
     if (phase_ == 1) {
@@ -295,8 +308,6 @@ class Estimator : public ImageDecoder<S, N> {
     } else if (phase_ == 2) {
       dec_.absolute(loss_, sig_);
     } else if (phase_ == 3) {
-      dec_.change(loss_, sig_, sd_max());
-    } else if (phase_ == 4) {
       dec_.decide(update_steps_, score_ > static_cast<S>(set_[kSuspect]));
       if (dec_.take_restart()) {
         const S keep = static_cast<S>(set_[kRestartKeep]);
@@ -304,7 +315,7 @@ class Estimator : public ImageDecoder<S, N> {
           for (int b = 0; b <= a; ++b) J_[a][b] *= keep, J0_[a][b] *= keep;
       }
     }
-    phase_ = phase_ >= 4 || !factored_ ? 0 : phase_ + 1;
+    phase_ = phase_ >= 3 || !factored_ ? 0 : phase_ + 1;
   }
   // The score statistic Gs' Is^-1 Gs (a tenth of the prior's information
   // added, for the first seconds): chi-square with np degrees of freedom
@@ -324,31 +335,29 @@ class Estimator : public ImageDecoder<S, N> {
     }
     return t;
   }
-  S sd_max() const {
-    S m(0);
-    for (int j = 0; j < d_.stories; ++j) m = sd_[j] > m ? sd_[j] : m;
-    return m;
-  }
   DecisionSettings<S> decision_settings() const {
     DecisionSettings<S> c;
     c.threshold = static_cast<S>(set_[kThreshold]);
     c.threshold_change = static_cast<S>(set_[kThresholdChange]);
     c.two = static_cast<S>(set_[kTwoStory]);
+    c.two_share = static_cast<S>(set_[kTwoShare]);
     c.separation = static_cast<S>(set_[kSeparation]);
     c.inflation = static_cast<S>(set_[kInflation]);
     c.drift_var = static_cast<S>(set_[kDriftVar]);
     c.snap_steps = static_cast<long>(set_[kSnapSteps]);
     c.hold_steps = hold_steps_;
     c.restart_steps = static_cast<long>(set_[kRestartSteps]);
+    c.before_var_max = static_cast<S>(set_[kBeforeVarMax]);
     return c;
   }
 
   // state
   S z_[kX] = {}, s_[kP][kX] = {}, a_ = S(0);
   S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
+  S Jc_[Decision<S, N>::kTri] = {}, bc_[kP] = {};  // the change tests' information since the start
   S r2_[kY] = {}, eps_[kY] = {};
   long held_[kP] = {};
-  long since_ = 0, impact_left_ = 0, k_ = 0;
+  long since_ = 0, impact_left_ = 0, k_ = 0, calm_ = 0;
   bool device_alarm_ = false, factored_ = false;
   int phase_ = 0;
   S F_[kP][kP] = {}, sig_[N][N] = {};  // the last factor of J + prior; the stories' covariance

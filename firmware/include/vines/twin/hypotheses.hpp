@@ -28,6 +28,22 @@ bool cholesky(S (&A)[N][N], int n) {
   return true;
 }
 
+// x <- (F F^T)^-1 x, F the lower factor of the leading n x n (forward, then
+// back substitution).
+template <typename S, int N>
+void solve_from_factor(const S (&F)[N][N], int n, S* x) {
+  for (int a = 0; a < n; ++a) {
+    S t = x[a];
+    for (int c = 0; c < a; ++c) t -= F[a][c] * x[c];
+    x[a] = t / F[a][a];
+  }
+  for (int a = n - 1; a >= 0; --a) {
+    S t = x[a];
+    for (int c = a + 1; c < n; ++c) t -= F[c][a] * x[c];
+    x[a] = t / F[a][a];
+  }
+}
+
 // The inverse P = (F F^T)^-1 from the lower factor F (leading n x n): the
 // inverse of F column by column, then its Gram matrix.
 template <typename S, int N>

@@ -34,7 +34,7 @@ inline constexpr int kMaxSensors = 8;
 inline constexpr std::uint8_t kNone8 = 255;  // "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
-inline constexpr std::uint16_t kTwinVersion = 3;
+inline constexpr std::uint16_t kTwinVersion = 4;
 
 // The state beyond the frame's 2N: none (bare frame), the device's force on
 // its floor as an unknown input (VI NES: one state), or the TMD's own mass
@@ -73,6 +73,9 @@ enum TwinSetting : int {
   kRestartSteps,  // ...at most once in this many steps...
   kRestartKeep,   // ...keeping this share of it
   kScoreForget,   // the score's memory per update (exp(-update / window))
+  kCalmSteps,     // a change test leaves out this many steps after each impact (VI NES)
+  kBeforeVarMax,  // a candidate onset: every story's fit before it within this variance
+  kTwoShare,      // two stories: ...and beyond the best story's by this share of it
   kTwinSettings
 };
 

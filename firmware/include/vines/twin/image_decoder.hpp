@@ -144,7 +144,9 @@ class ImageDecoder {
         !(c[kPeriod] > 0) || !(c[kJumpSigma] > 0) || !(c[kJumpHold] >= 0) || !(c[kThresholdChange] > 0) ||
         !(c[kTwoStory] >= 0) || !(c[kSeparation] >= 0) || !(c[kInflation] > 0) || !(c[kDriftVar] >= 0) ||
         !(c[kSnapSteps] >= 1 && c[kSnapSteps] <= 1e6) || !(c[kSuspect] > 0) || !(c[kRestartSteps] >= 0) ||
-        !(c[kRestartKeep] > 0 && c[kRestartKeep] <= 1) || !(c[kScoreForget] >= 0 && c[kScoreForget] < 1))
+        !(c[kRestartKeep] > 0 && c[kRestartKeep] <= 1) || !(c[kScoreForget] >= 0 && c[kScoreForget] < 1) ||
+        !(c[kCalmSteps] >= 0 && c[kCalmSteps] <= 1e6) || !(c[kBeforeVarMax] > 0) ||
+        !(c[kTwoShare] >= 0))
       return "twin image: a setting out of range";
     // The model's covariance: symmetric with a positive diagonal (the tests
     // add it to a positive definite one).
