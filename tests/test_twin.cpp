@@ -127,7 +127,7 @@ TEST(Twin, DamageDuringTheRecord) {
   ASSERT_TRUE(t.detected && t.story && t.size && t.detect_time_s && t.detect_delay_s);
   EXPECT_GT(*t.detect_time_s, 5.0);
   EXPECT_DOUBLE_EQ(*t.detect_delay_s, *t.detect_time_s - 5.0);
-  ASSERT_TRUE(t.onset_s);  // where the estimator's change score rose
+  ASSERT_TRUE(t.onset_s);  // the change test's candidate onset
   EXPECT_NEAR(*t.onset_s, 5.0, 2.0);
   EXPECT_EQ(t.stories, std::vector<int>{3});
   std::printf("damage at 5 s: story %d, loss %.3f, detected at %.3f s, delay %.3f s\n", *t.story, *t.size,
