@@ -200,8 +200,8 @@ class Estimator : public ImageDecoder<S, N> {
       // forgetting: a least-squares fit of any window of it is J^-1 b, the
       // innovation linearised about the estimate of its step (eps less
       // psi (theta - loss)), so that each window's fit is its own whatever
-      // the estimate did meanwhile. Impacts' samples left out: the frame's
-      // model does not explain them.
+      // the estimate did meanwhile. A VI NES's impacts and the kCalmSteps
+      // after each left out: the frame's model does not explain them.
       S yl = eps_[i];
       for (int a = 0; a < np; ++a) yl += psi[i][a] * loss_[a];
       for (int a = 0; a < np; ++a) {
