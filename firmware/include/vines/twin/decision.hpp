@@ -68,7 +68,7 @@ class Decision {
     restart_ = false, suspected_ = false, now_ = 0, rise_ = -1;
     detected_ = false, story_ = -1, second_ = -1, onset_ = -1;
     size_ = size2_ = S(0);
-    abs_.valid = scan_.valid = last_.valid = cand_.valid = false;
+    abs_.valid = scan_.valid = last_.valid = false;
     back_ = kMinAfter, phase_ = 0;
     for (int j = 0; j < N; ++j) evidence_[j] = S(0);
     lead_thr_ = s.threshold, reported_margin_ = S(0), reported_change_ = false;
@@ -135,9 +135,10 @@ class Decision {
       for (int c = 0; c <= a; ++c)
         A[a][c] = set_.inflation * (P1_[a][c] + P2_[a][c]) + (a == c ? set_.drift_var : S(0));
     }
-    run(A, th, &cand_);
-    cand_.onset_k = r.k;
-    if (cand_.valid && cand_.h.story >= 0 && (!scan_.valid || cand_.h.one > scan_.h.one)) scan_ = cand_;
+    Test cand;
+    run(A, th, &cand);
+    cand.onset_k = r.k;
+    if (cand.valid && cand.h.story >= 0 && (!scan_.valid || cand.h.one > scan_.h.one)) scan_ = cand;
     phase_ = 0, ++back_;
   }
 
@@ -276,8 +277,8 @@ class Decision {
   Snap ring_[kRing];
   int count_ = 0, head_ = 0;
   // The absolute test; the change scan's best so far, the last whole scan's
-  // best, the candidate in hand.
-  Test abs_, scan_, last_, cand_;
+  // best.
+  Test abs_, scan_, last_;
   int back_ = kMinAfter, phase_ = 0, ref_ = 0;
   long ref_k_ = -1;
   S before_[kP] = {}, after_[kP] = {}, P1_[N][N] = {}, P2_[N][N] = {};
