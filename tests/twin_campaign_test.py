@@ -20,6 +20,7 @@ import pytest
 SOURCE = os.environ.get("VINES_SOURCE_DIR") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(SOURCE, "tools"))
 import twin_benchmark as tb  # noqa: E402
+import twin_campaign_baseline as cb  # noqa: E402
 import twin_campaign_cases as cc  # noqa: E402
 import twin_campaign_table as ct  # noqa: E402
 
@@ -227,6 +228,38 @@ def test_device_health():
     assert h["stuck on a moving sphere"][2].startswith("0/4 = 0.0 %") and h["stuck on a moving sphere"][2].endswith("✓)")
 
 
+@pytest.mark.parametrize("quick", [False, True], ids=["default", "quick"])
+def test_commissioned_buildings(quick):
+    """Each device's buildings are commissioned on the three other earthquakes, each run adding to
+    its own baseline; their tests leave those records out, run every other record undamaged,
+    and lose each story (quick: 3 and 8) 5 and 10 % before the record, from the baseline, on
+    that building as it was commissioned."""
+    recs = fake_records()
+    n = 1 if quick else 3
+    with tempfile.TemporaryDirectory() as tmp:
+        bs = cb.drawn(recs, tmp, buildings=n, seed=11, seeds=5)
+        cases = cb.cases(bs, recs, quick=quick, seed=11, seeds=5, fail=pytest.fail)
+    assert len(bs) == n * len(cc.DEVICES) and len({b["baseline"] for b in bs}) == len(bs)
+    by = {b["baseline"]: b for b in bs}
+    for b in bs:
+        assert [os.path.basename(c["record"]) for c in b["commission"]] == list(cb.COMMISSION_RECORDS)
+        assert all(c["commission"] == b["baseline"] and not c["baseline"] and not c["damaged"] for c in b["commission"])
+        assert all(c["truth"]["frame"] == b["truth"]["frame"] for c in b["commission"])
+    for c in cases:
+        b = by[c["baseline"]]
+        assert c["device"] == b["device"] and os.path.basename(c["record"]) not in cb.COMMISSION_RECORDS
+        healthy = b["truth"]["frame"]["stiffness_scales"]
+        want = [x * (1 - c["loss"] if i + 1 in c["damaged"] else 1) for i, x in enumerate(healthy)]
+        assert c["truth"]["frame"]["stiffness_scales"] == pytest.approx(want)
+        assert c["truth"]["frame"]["masses_kg"] == b["truth"]["frame"]["masses_kg"] and "damage" not in c["truth"]
+    quiet = [c for c in cases if c["family"] == "undamaged baseline"]
+    assert len(quiet) == len(bs) * (len(recs) - len(cb.COMMISSION_RECORDS))
+    for device in cc.DEVICES:
+        lost = sorted((c["damaged"][0], c["loss"]) for c in cases if c["family"] == "before baseline" and c["device"] == device)
+        stories = (3, 8) if quick else range(1, 11)
+        assert lost == sorted((s, loss) for s in stories for loss in cb.LOSSES for _ in range(1 if quick else 2))
+
+
 def test_limit_keeps_every_family(design):
     _, _, cases = design
     families = list(dict.fromkeys(c["family"] for c in cases))
@@ -251,6 +284,8 @@ def test_missing_inputs_exit_2():
         if HAVE_RECORDS:
             p = tool("--vines", exe, "--records", RECORDS_DIR, "--baseline-dir", d)
             assert p.returncode == 2 and os.path.join(d, "none.toml") in p.stderr
+            p = tool("--vines", exe, "--records", RECORDS_DIR, "--commission", "-1")
+            assert p.returncode == 2 and "--commission -1" in p.stderr
 
 
 @pytest.mark.skipif(not (os.access(VINES, os.X_OK) and HAVE_RECORDS),

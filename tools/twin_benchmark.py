@@ -9,8 +9,10 @@ that are not their drawing (each story's stiffness within 3 %, each floor's mass
 NES eps within 2 %, the sphere or the TMD started elsewhere), undamaged, or losing 3, 5, 10 or
 20 % of one story at an onset drawn in the record's 25-75 % Arias span (every story and loss,
 spread over the records and noise seeds by a sampled design, deterministic from --design-seed),
-two stories 10 % during the record, one story 5 or 10 % before it (no baseline; with
---baseline-dir also from a commissioned baseline); detuned TMDs; a stuck sphere. Sensors: the
+two stories 10 % during the record, one story 5 or 10 % before it (no baseline); buildings
+commissioned on three other earthquakes, then run from their baseline, undamaged and with a
+story lost 5 or 10 % before the record (tools/twin_campaign_baseline.py); detuned TMDs; a stuck
+sphere. Sensors: the
 ground as the node's input and floors 3, 6, 8, 10 at 1 kHz, 5 % RMS noise.
 
 Prints the planned run count and an estimated time first, then one table: detection,
@@ -23,7 +25,8 @@ final loss estimate. Options the tool does not know go to `vines hil` (e.g. --tw
 
 Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--quick] [--seeds N]
                          [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES]
-                         [--limit N] [--duration S] [--baseline-dir DIR] [--bound-located 5=P,10=P]
+                         [--limit N] [--duration S] [--commission N | --baseline-dir DIR]
+                         [--bound-located 5=P,10=P] [--bound-located-baseline 5=P,10=P]
                          [--calibrate] [--json FILE] [--sensors LIST] [--noise-pct P] [--plan]
 Exit 2 with a message naming the input on a missing program, folder, record or baseline file.
 """
@@ -39,16 +42,17 @@ import subprocess
 import sys
 import tempfile
 import time
-import tomllib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import twin_campaign_baseline as cb  # noqa: E402
 import twin_campaign_cases as cc  # noqa: E402
 import twin_campaign_table as ct  # noqa: E402
 from twin_campaign_cases import (GAP_M, RECORDS, ROOT, TABLE1_K_MN, TABLE1_MASS_T, TMD_C, TMD_K,  # noqa: E402,F401
                                  building)
 
 CPU_S_PER_RECORD_S = 2.5 / 40  # a twin run's CPU per second of record (2-core VM, 1 kHz)
-FAMILIES = ("undamaged", "during", "two during", "before", "before baseline", "detuned", "stuck")
+FAMILIES = ("undamaged", "during", "two during", "before", "undamaged baseline", "before baseline", "detuned",
+            "stuck")
 
 
 def fail(msg):
@@ -71,45 +75,6 @@ def scene_text(tables):
                    for name, keys in tables.items() if keys is not None)
 
 
-def baseline_cases(args, records, rng_seed):
-    """Losses of 5 and 10 % before the record on the building a baseline was commissioned on:
-    DIR/<device>.toml (that healthy building, a truth scene), DIR/<device>.baseline (for
-    `vines hil --baseline`), DIR/<device>.records (optional: the records it was commissioned
-    on, one file name a line, left out here)."""
-    import random
-    rng, out = random.Random(rng_seed + 1), []
-    for device in cc.DEVICES:
-        paths = {e: os.path.join(args.baseline_dir, f"{device}.{e}") for e in ("toml", "baseline", "records")}
-        for e in ("toml", "baseline"):
-            if not os.path.isfile(paths[e]):
-                fail(f"{paths[e]}: no such file (--baseline-dir holds <device>.toml and <device>.baseline "
-                     f"for the devices {', '.join(cc.DEVICES)})")
-        with open(paths["toml"], "rb") as f:
-            healthy = tomllib.load(f)
-        used = set()
-        if os.path.isfile(paths["records"]):
-            used = {line.strip() for line in open(paths["records"]) if line.strip()}
-        recs = [r for r in records if r["name"] not in used]
-        if not recs:
-            fail(f"{paths['records']}: every record was used to commission the baseline: none left to test on")
-        base = healthy.get("frame", {}).get("stiffness_scales", [1.0] * 10)
-        k = 0
-        for loss in (0.05, 0.10):
-            for s in range(1, 11):
-                for _ in range(2 if not args.quick else 1):
-                    rec = recs[k % len(recs)]
-                    k += 1
-                    truth = json.loads(json.dumps(healthy))
-                    truth.setdefault("frame", {})["stiffness_scales"] = [b * (1 - loss if i == s - 1 else 1) for i, b in enumerate(base)]
-                    truth["record"] = dict({"path": rec["path"]}, **RECORDS[rec["name"]])
-                    out.append(dict(family="before baseline", label=f"loss {round(100 * loss)} % before, baseline",
-                                    device=device, record=rec["path"], sct=rec["sct"], truth=truth, damaged=[s],
-                                    loss=loss, onset_s=None, healthy=base, masses=None,
-                                    seed=1 + rng.randrange(args.seeds), duration_s=rec["duration_s"],
-                                    baseline=paths["baseline"]))
-    return out
-
-
 def run(args, tmp, i, case):
     """One `vines hil` twin run: the case with its report (twin, steps, wall) or its error."""
     node = os.path.join(tmp, f"node_{i}.toml")
@@ -124,6 +89,8 @@ def run(args, tmp, i, case):
            "--timeout", str(args.timeout), "--duration", f"{duration:.3f}"]
     if case.get("baseline"):
         cmd += ["--baseline", case["baseline"]]
+    if case.get("commission"):
+        cmd += ["--commission", case["commission"]]
     cmd += args.extra
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.run_timeout)
@@ -175,17 +142,21 @@ def parse_args(argv=None):
     ap.add_argument("--noise-pct", type=float, default=5)
     ap.add_argument("--quick", action="store_true", help="about 150 runs: each story and loss once over the devices")
     ap.add_argument("--calibrate", action="store_true", help="undamaged truths only; their largest estimates")
-    ap.add_argument("--baseline-dir", help="adds losses before the record with a baseline (see baseline_cases)")
+    ap.add_argument("--commission", type=int, help="healthy buildings per device commissioned on three other "
+                    "earthquakes, then run from their baseline (tools/twin_campaign_baseline.py; 3, quick 1; 0: none)")
+    ap.add_argument("--baseline-dir", help="the baselines instead from DIR (twin_campaign_baseline.from_dir)")
     ap.add_argument("--bound-located", help="loss=share of the bound tool's one-story GLRT, e.g. 5=0.27,10=0.95: "
                                             "the before-the-record rows' target is 0.9 x it")
+    ap.add_argument("--bound-located-baseline", help="the same for the rows run from a baseline, e.g. 5=0.99")
     ap.add_argument("--plan", action="store_true", help="print the planned runs and the time estimate, run nothing")
     ap.add_argument("--json", help="write every run's case and twin report to FILE")
     args, args.extra = ap.parse_known_args(argv)
     return args
 
 
-def prepare(args):
-    """The checked inputs and the runs: (records' info, cases). Exits 2 naming what is missing."""
+def prepare(args, tmp):
+    """The checked inputs and the runs: (records' info, cases, commissioning runs: their baselines
+    written in tmp). Exits 2 naming what is missing."""
     if not args.plan and not os.access(args.vines, os.X_OK):
         fail(f"{args.vines}: not an executable (build it: cmake --preset release && cmake --build --preset release)")
     if not os.path.isdir(args.records):
@@ -205,22 +176,42 @@ def prepare(args):
         for f in families:
             if f not in FAMILIES:
                 fail(f"--only {f}: not a family ({', '.join(FAMILIES)})")
-    if args.bound_located:
-        try:
-            args.bound = {int(k) / 100: float(v) for k, v in (x.split("=") for x in args.bound_located.split(","))}
-        except ValueError:
-            fail(f"--bound-located {args.bound_located}: expected LOSS_PCT=SHARE,..., e.g. 5=0.27,10=0.95")
-    else:
-        args.bound = None
+    args.bound = {"before": bound_shares(args.bound_located, "--bound-located"),
+                  "before baseline": bound_shares(args.bound_located_baseline, "--bound-located-baseline")}
     todo = cc.cases(records, quick=args.quick, seed=args.design_seed, seeds=args.seeds, calibrate=args.calibrate,
                     undamaged=args.undamaged, replicates=args.replicates, families=families)
-    if args.baseline_dir and not args.calibrate:
+    buildings = []
+    wanted = not families or {"undamaged baseline", "before baseline"} & set(families)
+    if args.baseline_dir and wanted and not args.calibrate:
         if not os.path.isdir(args.baseline_dir):
             fail(f"--baseline-dir {args.baseline_dir}: no such folder")
-        todo += [c for c in baseline_cases(args, records, args.design_seed) if not families or c["family"] in families]
+        buildings = cb.from_dir(args.baseline_dir, fail)
+    elif wanted and not args.calibrate:
+        n = args.commission if args.commission is not None else (1 if args.quick else 3)
+        if n < 0:
+            fail(f"--commission {n}: a count of buildings per device, 0 for none")
+        missing = [m for m in cb.COMMISSION_RECORDS if m not in {r["name"] for r in records}]
+        if n and missing:
+            fail(f"--commission: the commissioning records {', '.join(missing)} are not in {args.records}")
+        buildings = cb.drawn(records, tmp, buildings=n, seed=args.design_seed, seeds=args.seeds) if n else []
+    if buildings:
+        todo += [c for c in cb.cases(buildings, records, quick=args.quick, seed=args.design_seed, seeds=args.seeds,
+                                     fail=fail) if not families or c["family"] in families]
     if args.limit:
         todo = limited(todo, args.limit)
-    return records, todo
+    kept = {c.get("baseline") for c in todo}
+    commission = [c for b in buildings if b["baseline"] in kept for c in b["commission"]]
+    return records, todo, commission
+
+
+def bound_shares(text, flag):
+    """--bound-located's LOSS_PCT=SHARE,... as {loss: share}; None without it."""
+    if not text:
+        return None
+    try:
+        return {int(k) / 100: float(v) for k, v in (x.split("=") for x in text.split(","))}
+    except ValueError:
+        fail(f"{flag} {text}: expected LOSS_PCT=SHARE,..., e.g. 5=0.27,10=0.95")
 
 
 def estimate(args, todo):
@@ -237,12 +228,37 @@ def json_entry(r):
                 twin=r.get("twin"), steps=r.get("steps"), wall_time_s=r.get("wall"), error=r.get("error"))
 
 
+def commission(args, tmp, pool, runs):
+    """The commissioning runs, each baseline's in turn (they add to its file), the baselines at
+    once; exits 2 naming a run that failed (its baseline's tests would mean nothing)."""
+    by = collections.OrderedDict()
+    for c in runs:
+        by.setdefault(c["commission"], []).append(c)
+
+    def one(k, cs):
+        for j, c in enumerate(cs):
+            r = run(args, tmp, f"commission_{k}_{j}", c)
+            if "error" in r:
+                return r
+        return None
+
+    for r in pool.map(lambda kc: one(*kc), enumerate(by.values())):
+        if r is not None:
+            c = r["case"]
+            fail(f"commissioning {c['commission']} on {os.path.basename(c['record'])} failed: {r['error']}")
+
+
 def main(argv=None):
     args = parse_args(argv)
-    records, todo = prepare(args)
-    cpu, minutes = estimate(args, todo)
-    count = collections.Counter(c["family"] for c in todo)
-    print(f"twin_benchmark.py: planned {len(todo)} runs ({', '.join(f'{n} {f}' for f, n in count.items())}; "
+    with tempfile.TemporaryDirectory() as tmp:
+        return campaign(args, tmp)
+
+
+def campaign(args, tmp):
+    records, todo, runs = prepare(args, tmp)
+    cpu, minutes = estimate(args, todo + runs)
+    count = collections.Counter(c["family"] for c in todo + runs)
+    print(f"twin_benchmark.py: planned {len(todo) + len(runs)} runs ({', '.join(f'{n} {f}' for f, n in count.items())}; "
           f"{sum(c['sct'] for c in todo)} on SCT); estimated {cpu / 60:.0f} CPU min, about {minutes:.0f} min "
           f"on {args.jobs} jobs", file=sys.stderr, flush=True)
     if args.plan:
@@ -251,7 +267,11 @@ def main(argv=None):
                   f"{r['t75']:.1f} / {r['t95']:.1f} s, runs {r['duration_s']:.1f} s")
         return 0
     results, start = [], time.monotonic()
-    with tempfile.TemporaryDirectory() as tmp, cf.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+    with cf.ThreadPoolExecutor(max(1, args.jobs)) as pool:
+        if runs:
+            commission(args, tmp, pool, runs)
+            print(f"twin_benchmark.py: {len(runs)} commissioning runs, {(time.monotonic() - start) / 60:.1f} min",
+                  file=sys.stderr, flush=True)
         futures = [pool.submit(run, args, tmp, i, c) for i, c in enumerate(todo)]
         for n, f in enumerate(cf.as_completed(futures), 1):
             results.append(f.result())

@@ -15,6 +15,8 @@ LOCATE_WITHIN_S, ONSET_WITHIN_S, IMPULSE_SHARE = 20.0, 2.0, 0.25
 # (family, loss) -> {column: (">=" | "<=", percent)}
 TARGETS = {
     ("undamaged", 0.0): {"false alarms": ("<=", 1.0)},
+    ("undamaged baseline", 0.0): {"false alarms": ("<=", 1.0)},
+    ("before baseline", 0.10): {"located": (">=", 95.0), "size within": (">=", 95.0)},
     ("during", 0.10): {"located <=20 s": (">=", 95.0), "size within": (">=", 95.0)},
     ("during", 0.05): {"located": (">=", 90.0), "size within": (">=", 90.0), "onset within 2 s": (">=", 90.0)},
     ("during", 0.03): {"located": (">=", 80.0), "size within": (">=", 75.0)},
@@ -103,7 +105,10 @@ def group_key(r):
     return ("SCT" if c["sct"] else "9 records", c["device"], c["family"], c["loss"], c["label"])
 
 
-ORDER = {"undamaged": 0, "during": 1, "two during": 2, "before": 3, "detuned": 4, "stuck": 5}
+ORDER = {"undamaged": 0, "during": 1, "two during": 2, "before": 3, "undamaged baseline": 4, "before baseline": 5,
+         "detuned": 6, "stuck": 7}
+QUIET = ("undamaged", "undamaged baseline", "stuck")  # no damage: false alarms
+BEFORE = ("before", "before baseline")
 HEAD = ("records", "device", "truth", "runs", "failed", "detected", "located", "located <=20 s", "size err pt mean/p90",
         "size within", "onset err s mean/p90", "onset within 2 s", "delay s mean/p90", "false alarms [95 % CI]",
         "roof NRMSE mean/p90", "us/step")
@@ -112,15 +117,16 @@ HEAD = ("records", "device", "truth", "runs", "failed", "detected", "located", "
 def rows(results, bound_located=None):
     """The table's rows (tuples of strings, HEAD's columns): per records set (the nine records,
     SCT, every record: the targets hold for every record), device and truth; then every device
-    and record together for the undamaged runs (the false alarm target counts them all). bound_located: loss -> the bound tool's located share, for
-    the before-the-record rows' target (0.9 x it)."""
+    and record together for the undamaged runs (the false alarm target counts them all).
+    bound_located: family ("before", "before baseline") -> {loss: the bound tool's located
+    share}, for the before-the-record rows' target (0.9 x it)."""
     groups = {}
     for r in results:
         k = group_key(r)
         groups.setdefault(k, []).append(r)
         groups.setdefault(("every record",) + k[1:], []).append(r)
-        if r["case"]["family"] == "undamaged":
-            groups.setdefault(("every record", "all", "undamaged", 0.0, "undamaged"), []).append(r)
+        if r["case"]["family"] in QUIET[:2]:
+            groups.setdefault(("every record", "all") + k[2:], []).append(r)
     out = []
     section = {"9 records": 0, "SCT": 1, "every record": 2}
     for key in sorted(groups, key=lambda k: (section[k[0]], k[1] == "all", k[1], ORDER[k[2]], k[3])):
@@ -130,24 +136,25 @@ def rows(results, bound_located=None):
         sc = [score(r) for r in ok]
         tw = [r["twin"] for r in ok]
         tg = dict(TARGETS.get((family, loss), {}))
-        if family == "before" and bound_located and loss in bound_located:
-            tg["located"] = (">=", round(90 * bound_located[loss], 1))
-        damaged = family in ("during", "two during", "before")
-        single = family in ("during", "before")
+        bound = (bound_located or {}).get(family) or {}
+        if family in BEFORE and loss in bound:
+            tg["located"] = (">=", round(90 * bound[loss], 1))
+        damaged = family in ("during", "two during") + BEFORE
+        single = family == "during" or family in BEFORE
         det = [s["detected"] for s in sc]
         if family == "detuned":
             det = [bool(t.get("device", {}).get("detuned")) for t in tw]
         thr = SIZE_PT.get(loss)
         size_ok = [s["size_err"] is not None and s["size_err"] <= thr for s in sc] if single and thr else []
         fa = ""
-        if family in ("undamaged", "stuck"):
+        if family in QUIET:
             k, n = sum(det), len(det)
             lo, hi = wilson(k, n)
             fa = f"{k}/{n} = {pct(k, n).strip()} [{100 * lo:.1f}, {100 * hi:.1f}]" + \
                 mark(100 * k / n if n else None, tg.get("false alarms")) if n else "-"
         us = [1e6 * r["wall"] / max(1, r["steps"]) for r in ok]
         out.append((where, DEVICE_NAMES[device], label, str(len(rs)), str(len(rs) - len(ok)),
-                    share(det) if family not in ("undamaged", "stuck") else "",
+                    share(det) if family not in QUIET else "",
                     share([s["located"] for s in sc], tg.get("located")) if damaged else "",
                     share([s["located20"] for s in sc], tg.get("located <=20 s")) if family.endswith("during") else "",
                     stat([s["size_err"] for s in sc if s["size_err"] is not None], "%.2f") if single else "",
