@@ -84,6 +84,7 @@ TEST(TwinDecision, HypothesesMatchGeneralisedLeastSquares) {
 // the node spreads it.
 struct Synthetic {
   double scale = 7.0;
+  double misfit = 1.0;  // the estimator's misfit the absolute test is told of
   double run(Decision<double, N>* d, const double (&before)[N], const double (&after)[N], const double (&bias)[N],
              double onset, double T, std::uint64_t seed) const {
     std::mt19937_64 rng(seed);
@@ -117,7 +118,7 @@ struct Synthetic {
         for (int b = 0; b < N; ++b) sig[a][b] = P(a, b);
       }
       d->observe(k, loss, Jc, bc);
-      d->absolute(loss, sig);
+      d->absolute(loss, sig, misfit);
       for (int part = 0; part < 9; ++part) d->scan(Jc, bc);
       d->decide(1);
       if (detect < 0 && d->detected()) detect = t;
@@ -213,6 +214,23 @@ TEST(TwinDecision, LossBeforeTheRecordFoundAgainstTheBaseline) {
   ASSERT_TRUE(d.detected());
   EXPECT_EQ(d.story(), 8);
   EXPECT_NEAR(d.size(), 0.05, 0.01);
+}
+
+TEST(TwinDecision, MisfitWidensTheAbsoluteTest) {
+  // The same loss before the record, the estimator reporting a misfit: its
+  // estimate's covariance 100 times wider (sd 10 times, about 5 %), the 5 %
+  // loss is within it and raises no alarm; a misfit of 1 is the test above.
+  double base[N], sigma0[N][N] = {}, before[N], after[N], bias[N] = {};
+  for (int a = 0; a < N; ++a) base[a] = before[a] = after[a] = a % 2 ? 0.02 : -0.02, sigma0[a][a] = 0.005 * 0.005;
+  after[7] += 0.05;
+  for (double misfit : {1.0, 100.0}) {
+    Decision<double, N> d;
+    d.init(N, N, settings(), base, sigma0, kPrior);
+    Synthetic run;
+    run.misfit = misfit;
+    run.run(&d, before, after, bias, 0.0, 40.0, 11);
+    EXPECT_EQ(d.detected(), misfit == 1.0) << misfit;
+  }
 }
 
 }  // namespace

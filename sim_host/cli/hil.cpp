@@ -355,6 +355,9 @@ void add_hil(CLI::App& vines) {
       {"--twin-calm", {&tu.calm_s, "a change test leaves out this long after each VI NES impact [s]"}},
       {"--twin-before-sd", {&tu.before_sd_max, "a candidate onset: every story's fit before it within this sd"}},
       {"--twin-score-window", {&tu.score_window_s, "the change score's memory [s]"}},
+      {"--twin-misfit-level", {&tu.misfit_level, "the change score per parameter of a model that holds; beyond "
+                                                 "it, the absolute test's estimate covariance times the excess..."}},
+      {"--twin-misfit-memory", {&tu.misfit_memory_s, "...held this long [s]"}},
       {"--twin-suspect", {&tu.suspect, "the change score beyond this restarts the losses' information..."}},
       {"--twin-restart-gap", {&tu.restart_gap_s, "...at most once in this long [s]..."}},
       {"--twin-restart-keep", {&tu.restart_keep, "...keeping this share of it"}},

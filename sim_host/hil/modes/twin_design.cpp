@@ -228,6 +228,8 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kRestartKeep] = std::min(1.0, t.restart_keep);
   set[twin::kScoreForget] = std::exp(-set[twin::kUpdateSteps] * h / t.score_window_s);
   set[twin::kCalmSteps] = std::round(t.calm_s / h);
+  set[twin::kMisfitLevel] = t.misfit_level;
+  set[twin::kMisfitForget] = std::exp(-set[twin::kUpdateSteps] * h / t.misfit_memory_s);
   set[twin::kBeforeVarMax] = t.before_sd_max * t.before_sd_max;
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);

@@ -87,12 +87,13 @@ class Decision {
     if (count_ < kRing) ++count_;
   }
 
-  // The absolute test on the losses with the estimate's covariance sig.
-  void absolute(const S* loss, const S (&sig)[N][N]) {
+  // The absolute test on the losses with the estimate's covariance sig,
+  // times misfit (>= 1: the model's misfit, twin/estimator.hpp).
+  void absolute(const S* loss, const S (&sig)[N][N], S misfit) {
     S A[N][N], th[N] = {};
     for (int a = 0; a < n_; ++a) {
       th[a] = loss[a] - base_[a];
-      for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * sig[a][b] + sigma0_[a][b];
+      for (int b = 0; b <= a; ++b) A[a][b] = set_.inflation * misfit * sig[a][b] + sigma0_[a][b];
     }
     run(A, th, &abs_);
     abs_.onset_k = -1;

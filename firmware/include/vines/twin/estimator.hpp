@@ -43,7 +43,7 @@ class Estimator : public ImageDecoder<S, N> {
     }
     for (S& v : Jc_) v = S(0);
     for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
-    since_ = 0, k_ = 0, phase_ = 0, score_ = S(0);
+    since_ = 0, k_ = 0, phase_ = 0, score_ = S(0), misfit_ = S(0);
     lam_update_ = static_cast<S>(std::pow(set_[kForget], static_cast<double>(update_steps_)));
     for (int a = 0; a < kP; ++a) {
       Gs_[a] = S(0);
@@ -305,8 +305,15 @@ class Estimator : public ImageDecoder<S, N> {
       for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b) sig_[a][b] = P[a][b];
       score_ = score();
+      // The misfit: the score beyond what a model that holds gives, held
+      // with its memory. The estimate's error is then more than its
+      // information says (the first seconds of strong motion, a record the
+      // model does not explain): the absolute test's covariance times it.
+      const S m = score_ / (static_cast<S>(set_[kMisfitLevel]) * static_cast<S>(d_.np));
+      misfit_ *= static_cast<S>(set_[kMisfitForget]);
+      if (m > misfit_) misfit_ = m;
     } else if (phase_ == 2) {
-      dec_.absolute(loss_, sig_);
+      dec_.absolute(loss_, sig_, misfit_ > S(1) ? misfit_ : S(1));
     } else if (phase_ == 3) {
       dec_.decide(update_steps_, score_ > static_cast<S>(set_[kSuspect]));
       if (dec_.take_restart()) {
@@ -362,6 +369,7 @@ class Estimator : public ImageDecoder<S, N> {
   int phase_ = 0;
   S F_[kP][kP] = {}, sig_[N][N] = {};  // the last factor of J + prior; the stories' covariance
   S J0_[kP][kP] = {}, Is_[kP][kP] = {}, Gs_[kP] = {}, score_ = S(0), lam_update_ = S(1);  // the score
+  S misfit_ = S(0);  // the score's excess, held (section 5)
   Decision<S, N> dec_;
 };
 

@@ -34,7 +34,7 @@ inline constexpr int kMaxSensors = 8;
 inline constexpr std::uint8_t kNone8 = 255;  // "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
-inline constexpr std::uint16_t kTwinVersion = 4;
+inline constexpr std::uint16_t kTwinVersion = 5;
 
 // The state beyond the frame's 2N: none (bare frame), the device's force on
 // its floor as an unknown input (VI NES: one state), or the TMD's own mass
@@ -76,6 +76,8 @@ enum TwinSetting : int {
   kCalmSteps,     // a change test leaves out this many steps after each impact (VI NES)
   kBeforeVarMax,  // a candidate onset: every story's fit before it within this variance
   kTwoShare,      // two stories: ...and beyond the best story's by this share of it
+  kMisfitLevel,   // the score per parameter of a model that holds: beyond it, the misfit...
+  kMisfitForget,  // ...held with this memory per update, scales the absolute test's estimate covariance
   kTwinSettings
 };
 
