@@ -109,6 +109,7 @@ ORDER = {"undamaged": 0, "during": 1, "two during": 2, "before": 3, "undamaged b
          "detuned": 6, "stuck": 7}
 QUIET = ("undamaged", "undamaged baseline", "stuck")  # no damage: false alarms
 BEFORE = ("before", "before baseline")
+POOLED = {"undamaged": "undamaged", "undamaged baseline": "undamaged, baseline"}  # every device and record too
 HEAD = ("records", "device", "truth", "runs", "failed", "detected", "located", "located <=20 s", "size err pt mean/p90",
         "size within", "onset err s mean/p90", "onset within 2 s", "delay s mean/p90", "false alarms [95 % CI]",
         "roof NRMSE mean/p90", "us/step")
@@ -125,8 +126,9 @@ def rows(results, bound_located=None):
         k = group_key(r)
         groups.setdefault(k, []).append(r)
         groups.setdefault(("every record",) + k[1:], []).append(r)
-        if r["case"]["family"] in QUIET[:2]:
-            groups.setdefault(("every record", "all") + k[2:], []).append(r)
+        if r["case"]["family"] in POOLED:
+            fam = r["case"]["family"]
+            groups.setdefault(("every record", "all", fam, 0.0, POOLED[fam]), []).append(r)
     out = []
     section = {"9 records": 0, "SCT": 1, "every record": 2}
     for key in sorted(groups, key=lambda k: (section[k[0]], k[1] == "all", k[1], ORDER[k[2]], k[3])):
