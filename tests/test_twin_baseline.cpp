@@ -1,15 +1,17 @@
 // The twin's commissioning baseline (docs/twin.md section 5): runs on the
 // healthy building written to a baseline file, its statistics against a
-// hand computation, a baseline of another building refused, and a 5 % loss
+// hand computation, a baseline of another building refused, a run its model
+// does not explain not added, and a 5 % loss
 // in a building that is not its drawing found against the baseline.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 
 #include "sim_host/hil/hil.hpp"
 #include "sim_host/hil/modes/twin_baseline.hpp"
@@ -84,6 +86,34 @@ TEST(TwinBaseline, AnotherBuildingOrAFileThatIsNoBaselineRefused) {
   std::ofstream(path) << R"({"format": "vines twin baseline", "version": 1, "stories": 10, "device": "none",
     "sensors": [3, 6, 8, 10], "sensor_rate_hz": 1000.0, "runs": [{"loss": [0, 0], "loss_sd": [0, 0]}]})";
   EXPECT_NE(refusal(path, b).find("not a list of 10 numbers"), std::string::npos);
+  std::remove(path.c_str());
+}
+
+// A run whose estimates a building of this drawing cannot have (its report's
+// caveat) is not added: the file is not created, the refusal names it and
+// the caveat.
+TEST(TwinBaseline, RunTheModelDoesNotExplainNotCommissioned) {
+  const std::string path = temp_path("caveat.json");
+  std::remove(path.c_str());
+  TwinBuilding b{2, "none", {1, 2}, 1000.0};
+  HilTwinReport run;
+  run.eta_k = {1.35, 0.97};
+  run.eta_k_sd = {0.01, 0.01};
+  run.caveat = "the estimates leave what a building of this drawing can be (story 1 at 1.350 of its drawing)";
+  std::string said;
+  try {
+    commission_twin(path, b, run, "record.at2");
+  } catch (const std::runtime_error& e) {
+    said = e.what();
+  }
+  EXPECT_NE(said.find(path), std::string::npos) << said;
+  EXPECT_NE(said.find("not added"), std::string::npos) << said;
+  EXPECT_NE(said.find("story 1 at 1.350"), std::string::npos) << said;
+  struct stat st {};
+  EXPECT_NE(::stat(path.c_str(), &st), 0) << "no file written";
+  run.caveat.clear();
+  commission_twin(path, b, run, "record.at2");
+  EXPECT_EQ(::stat(path.c_str(), &st), 0);
   std::remove(path.c_str());
 }
 

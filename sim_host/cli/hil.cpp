@@ -78,10 +78,12 @@ int hil(const HilArgs& a) {
     page->stop(a.serve_hold_s > 0 ? std::chrono::milliseconds(std::llround(1e3 * a.serve_hold_s))
                                   : std::chrono::milliseconds(2000),
                a.serve_hold_s > 0);
-  if (!a.opt.commission_path.empty() && r.twin && r.twin->estimator != "none")
-    host::commission_twin(a.opt.commission_path, host::twin_building(scene, a.opt), *r.twin, scene.record.path);
   if (a.as_json) std::printf("%s\n", host::to_json(r).dump().c_str());
   else print_hil(r);
+  // After the report, so that a run refused as a baseline is still seen.
+  std::fflush(stdout);
+  if (!a.opt.commission_path.empty() && r.twin && r.twin->estimator != "none")
+    host::commission_twin(a.opt.commission_path, host::twin_building(scene, a.opt), *r.twin, scene.record.path);
   if (!r.outputs_finite) return kRefused;
   // A fault kind not survived: the run finished, its results are degraded.
   if (!r.survived) {
@@ -285,7 +287,7 @@ void add_hil(CLI::App& vines) {
       ->group(twin);
   cmd->add_option("--commission", opt.commission_path,
                   "the run is on the healthy building: add its identified stories to this baseline file "
-                  "(created if missing; one run per healthy record)")
+                  "(created if missing; one run per healthy record; a run whose report has a caveat is refused, exit 1)")
       ->type_name("FILE")
       ->check(non_empty_path())
       ->group(twin);

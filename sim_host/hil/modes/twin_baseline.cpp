@@ -113,6 +113,9 @@ TwinBaselineStats load_twin_baseline(const std::string& path, const TwinBuilding
 void commission_twin(const std::string& path, const TwinBuilding& b, const HilTwinReport& run,
                      const std::string& record) {
   json j = read(path, b, true);
+  // A run the twin's model does not explain is no picture of the healthy
+  // building: its estimates would widen (or shift) the baseline.
+  if (!run.caveat.empty()) fail(path, "this run is not added to it: " + run.caveat);
   json r = {{"truth", run.truth}, {"record", record}, {"loss", json::array()}, {"loss_sd", run.eta_k_sd}};
   for (double e : run.eta_k) r["loss"].push_back(1.0 - e);
   j["runs"].push_back(r);

@@ -39,7 +39,9 @@ TwinBuilding twin_building(const Scene& node, const HilOptions& o);
 TwinBaselineStats load_twin_baseline(const std::string& path, const TwinBuilding& b, const TwinTuning& t);
 
 // Adds the run's final estimates to FILE (created if missing; atomically
-// replaced), after checking that FILE is a baseline of this building.
+// replaced), after checking that FILE is a baseline of this building and
+// that the run has no caveat (its estimates outside what a building of this
+// drawing can be: not added, std::runtime_error naming FILE and the caveat).
 void commission_twin(const std::string& path, const TwinBuilding& b, const HilTwinReport& run,
                      const std::string& record);
 
