@@ -145,7 +145,7 @@ async function main() {
   const csv = path.join(out, "twin.csv");
   const run = start(["hil", "data/scenes/elcentro_vines.toml", "--mode", "twin", "--truth",
     "data/scenes/twin/truth_story3_loss10.toml", "--sensors", "3,6,8,10", "--measure-noise-pct", "5",
-    "--floors", "3,6", "--realtime", "--grace", "1000", "--duration", "16", "--serve", "0", "--csv", csv, "--json"]);
+    "--floors", "3,6", "--realtime", "--grace", "1000", "--duration", "28", "--serve", "0", "--csv", csv, "--json"]);
   const url = await run.url;
   const browser = await puppeteer.launch({ executablePath: chromium, headless: true,
     args: ["--no-sandbox", "--disable-gpu", "--window-size=1920,1080"], defaultViewport: { width: 1280, height: 900 } });
