@@ -86,7 +86,19 @@ TEST(TwinBaseline, AnotherBuildingOrAFileThatIsNoBaselineRefused) {
   std::ofstream(path) << R"({"format": "vines twin baseline", "version": 1, "stories": 10, "device": "none",
     "sensors": [3, 6, 8, 10], "sensor_rate_hz": 1000.0, "runs": [{"loss": [0, 0], "loss_sd": [0, 0]}]})";
   EXPECT_NE(refusal(path, b).find("not a list of 10 numbers"), std::string::npos);
+  // A file a commissioning run could not add to is refused before the run;
+  // a missing one is fine (the run creates it).
+  std::ofstream(path) << R"({"format": "vines twin baseline", "version": 1, "stories": 10, "device": "none",
+    "sensors": [3, 6, 10], "sensor_rate_hz": 1000.0, "runs": []})";
+  std::string said;
+  try {
+    check_commission_file(path, b);
+  } catch (const std::runtime_error& e) {
+    said = e.what();
+  }
+  EXPECT_NE(said.find("a baseline of another building"), std::string::npos) << said;
   std::remove(path.c_str());
+  EXPECT_NO_THROW(check_commission_file(path, b));
 }
 
 // A run whose estimates a building of this drawing cannot have (its report's

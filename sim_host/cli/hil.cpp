@@ -65,6 +65,8 @@ void check_options(const HilArgs& a) {
 int hil(const HilArgs& a) {
   check_options(a);
   const host::Scene scene = host::load_scene(a.scene_path);
+  if (!a.opt.commission_path.empty())
+    host::check_commission_file(a.opt.commission_path, host::twin_building(scene, a.opt));
   // The page (--serve) listens before the bench starts; after the run its
   // clients get up to 2 s to read the report, or with --serve-hold up to S
   // for one to have read the whole run.

@@ -110,6 +110,8 @@ TwinBaselineStats load_twin_baseline(const std::string& path, const TwinBuilding
   return s;
 }
 
+void check_commission_file(const std::string& path, const TwinBuilding& b) { read(path, b, true); }
+
 void commission_twin(const std::string& path, const TwinBuilding& b, const HilTwinReport& run,
                      const std::string& record) {
   json j = read(path, b, true);

@@ -38,6 +38,10 @@ TwinBuilding twin_building(const Scene& node, const HilOptions& o);
 // wrong (not a baseline, another building, no run, a value not finite).
 TwinBaselineStats load_twin_baseline(const std::string& path, const TwinBuilding& b, const TwinTuning& t);
 
+// Throws as commission_twin would if FILE (missing is fine) cannot take
+// this building's runs: checked before a commissioning run, not after it.
+void check_commission_file(const std::string& path, const TwinBuilding& b);
+
 // Adds the run's final estimates to FILE (created if missing; atomically
 // replaced), after checking that FILE is a baseline of this building and
 // that the run has no caveat (its estimates outside what a building of this
