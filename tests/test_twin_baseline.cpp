@@ -39,13 +39,19 @@ std::string temp_path(const char* name) {
   return "/tmp/vines_test_twin_baseline_" + std::to_string(::getpid()) + "_" + name;
 }
 
-std::string refusal(const std::string& path, const TwinBuilding& b) {
+// What f threw ("": nothing).
+template <typename F>
+std::string thrown(F f) {
   try {
-    load_twin_baseline(path, b, TwinTuning{});
+    f();
   } catch (const std::runtime_error& e) {
     return e.what();
   }
   return "";
+}
+
+std::string refusal(const std::string& path, const TwinBuilding& b) {
+  return thrown([&] { load_twin_baseline(path, b, TwinTuning{}); });
 }
 
 TEST(TwinBaseline, StatisticsOfTheRuns) {
@@ -90,12 +96,7 @@ TEST(TwinBaseline, AnotherBuildingOrAFileThatIsNoBaselineRefused) {
   // a missing one is fine (the run creates it).
   std::ofstream(path) << R"({"format": "vines twin baseline", "version": 1, "stories": 10, "device": "none",
     "sensors": [3, 6, 10], "sensor_rate_hz": 1000.0, "runs": []})";
-  std::string said;
-  try {
-    check_commission_file(path, b);
-  } catch (const std::runtime_error& e) {
-    said = e.what();
-  }
+  const std::string said = thrown([&] { check_commission_file(path, b); });
   EXPECT_NE(said.find("a baseline of another building"), std::string::npos) << said;
   std::remove(path.c_str());
   EXPECT_NO_THROW(check_commission_file(path, b));
@@ -112,12 +113,7 @@ TEST(TwinBaseline, RunTheModelDoesNotExplainNotCommissioned) {
   run.eta_k = {1.35, 0.97};
   run.eta_k_sd = {0.01, 0.01};
   run.caveat = "the estimates leave what a building of this drawing can be (story 1 at 1.350 of its drawing)";
-  std::string said;
-  try {
-    commission_twin(path, b, run, "record.at2");
-  } catch (const std::runtime_error& e) {
-    said = e.what();
-  }
+  const std::string said = thrown([&] { commission_twin(path, b, run, "record.at2"); });
   EXPECT_NE(said.find(path), std::string::npos) << said;
   EXPECT_NE(said.find("not added"), std::string::npos) << said;
   EXPECT_NE(said.find("story 1 at 1.350"), std::string::npos) << said;
