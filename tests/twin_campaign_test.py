@@ -290,6 +290,20 @@ def test_missing_inputs_exit_2():
 
 @pytest.mark.skipif(not (os.access(VINES, os.X_OK) and HAVE_RECORDS),
                     reason=f"needs the program ({VINES}) and the ground motions ({RECORDS_DIR})")
+def test_devices_chosen():
+    def planned(*args):
+        p = tool("--vines", VINES, "--records", RECORDS_DIR, "--only", "during", "--plan", *args)
+        assert p.returncode == 0, p.stderr
+        return int(p.stderr.split("planned ")[1].split()[0])
+    every = planned()
+    assert planned("--devices", "vines") * 3 == every  # each device has as many runs during the record
+    assert planned("--devices", "none,tmd") * 3 == every * 2
+    p = tool("--vines", VINES, "--records", RECORDS_DIR, "--devices", "vinez", "--plan")
+    assert p.returncode == 2 and "--devices vinez: not a device" in p.stderr
+
+
+@pytest.mark.skipif(not (os.access(VINES, os.X_OK) and HAVE_RECORDS),
+                    reason=f"needs the program ({VINES}) and the ground motions ({RECORDS_DIR})")
 def test_tiny_real_run():
     with tempfile.TemporaryDirectory() as d:
         out = os.path.join(d, "runs.json")

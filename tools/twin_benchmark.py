@@ -47,7 +47,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import twin_campaign_baseline as cb  # noqa: E402
 import twin_campaign_cases as cc  # noqa: E402
 import twin_campaign_table as ct  # noqa: E402
-from twin_campaign_cases import (GAP_M, RECORDS, ROOT, TABLE1_K_MN, TABLE1_MASS_T, TMD_C, TMD_K,  # noqa: E402,F401
+from twin_campaign_cases import (DEVICES, GAP_M, RECORDS, ROOT, TABLE1_K_MN, TABLE1_MASS_T, TMD_C, TMD_K,  # noqa: E402,F401
                                  building)
 
 CPU_S_PER_RECORD_S = 2.5 / 40  # a twin run's CPU per second of record (2-core VM, 1 kHz)
@@ -134,6 +134,7 @@ def parse_args(argv=None):
                     help="runs per device, story and loss during the record (10; quick 0: each once over the devices)")
     ap.add_argument("--design-seed", type=int, default=20261125, help="the design's seed: truths, onsets, assignment")
     ap.add_argument("--only", help="families, comma-separated: " + ", ".join(FAMILIES))
+    ap.add_argument("--devices", help="devices, comma-separated: " + ", ".join(DEVICES))
     ap.add_argument("--limit", type=int, help="the first N runs, round-robin over the families")
     ap.add_argument("--duration", type=float, help="S seconds of every record instead of the Arias rule")
     ap.add_argument("--timeout", type=float, default=60, help="vines hil --timeout: longest wait for the node [s]")
@@ -176,6 +177,12 @@ def prepare(args, tmp):
         for f in families:
             if f not in FAMILIES:
                 fail(f"--only {f}: not a family ({', '.join(FAMILIES)})")
+    devices = None
+    if args.devices:
+        devices = [d.strip() for d in args.devices.split(",") if d.strip()]
+        for d in devices:
+            if d not in DEVICES:
+                fail(f"--devices {d}: not a device ({', '.join(DEVICES)})")
     args.bound = {"before": bound_shares(args.bound_located, "--bound-located"),
                   "before baseline": bound_shares(args.bound_located_baseline, "--bound-located-baseline")}
     todo = cc.cases(records, quick=args.quick, seed=args.design_seed, seeds=args.seeds, calibrate=args.calibrate,
@@ -197,6 +204,8 @@ def prepare(args, tmp):
     if buildings:
         todo += [c for c in cb.cases(buildings, records, quick=args.quick, seed=args.design_seed, seeds=args.seeds,
                                      fail=fail) if not families or c["family"] in families]
+    if devices:
+        todo = [c for c in todo if c["device"] in devices]
     if args.limit:
         todo = limited(todo, args.limit)
     kept = {c.get("baseline") for c in todo}
