@@ -23,7 +23,9 @@
 // story's by the separation ("damage, story not identified" otherwise), two
 // stories when the pair beats the best one by the two-story margin. A
 // candidate held for the hold time raises the alarm, which latches; the
-// verdict is the last candidate held (a change test's: the strongest).
+// verdict is the last candidate held, but once a change test's is reported
+// only a stronger change test's replaces it. Sizes are shares of the
+// stiffness the story had (before the onset, or in the baseline).
 #pragma once
 
 #include <cmath>
@@ -97,6 +99,7 @@ class Decision {
     }
     run(A, th, &abs_);
     abs_.onset_k = -1;
+    for (int a = 0; a < n_; ++a) abs_.ref[a] = base_[a];
   }
 
   // One part of the change scan, on the information so far (J, b): a
@@ -139,6 +142,7 @@ class Decision {
     Test cand;
     run(A, th, &cand);
     cand.onset_k = r.k;
+    for (int a = 0; a < n_; ++a) cand.ref[a] = before_[a];
     if (cand.valid && cand.h.story >= 0 && (!scan_.valid || cand.h.one > scan_.h.one)) scan_ = cand;
     phase_ = 0, ++back_;
   }
@@ -173,16 +177,21 @@ class Decision {
     // The verdict: the last candidate held, but for a change test's weaker
     // than the change test's it stands for (its evidence grows with the data
     // after its onset, until the onset leaves the snapshots' span and only
-    // later, weaker candidates remain).
+    // later, weaker candidates remain), and against the absolute test's: the
+    // change test measures the change alone, the absolute test the change
+    // plus the building's own departure from its drawing or baseline (its
+    // size off by that departure, its onset only where the score rose).
     if (!best || held_ < set_.hold_steps) return;
-    if (detected_ && best->onset_k >= 0 && reported_change_ && lead_margin < reported_margin_) return;
+    if (detected_ && reported_change_ && (best->onset_k < 0 || lead_margin < reported_margin_)) return;
     detected_ = true, reported_margin_ = lead_margin, reported_change_ = best->onset_k >= 0;
     const Hypotheses<S, N>& h = best->h;
+    // Sizes as shares of the stiffness the story had: of the window before
+    // the onset's fit, or of the baseline's (the drawing's without one).
     if (h.two - h.one > set_.two + set_.two_share * h.one) {
-      story_ = h.a, second_ = h.b, size_ = h.size_a, size2_ = h.size_b;
+      story_ = h.a, second_ = h.b, size_ = share(h.size_a, best->ref[h.a]), size2_ = share(h.size_b, best->ref[h.b]);
     } else {
       story_ = h.one - h.runner > set_.separation ? h.story : -1;
-      second_ = -1, size_ = h.size[h.story], size2_ = S(0);
+      second_ = -1, size_ = share(h.size[h.story], best->ref[h.story]), size2_ = S(0);
     }
     // The onset: a change test's candidate; for the absolute test, where the
     // score last rose, if it did within the snapshots' span, else where the
@@ -218,9 +227,13 @@ class Decision {
   struct Test {
     bool valid = false;
     long onset_k = -1;  // a change test's onset candidate (-1: the absolute test)
+    S ref[N] = {};      // the losses it measures the change from
     S row[N] = {};      // its best story's row of the precision
     Hypotheses<S, N> h;
   };
+
+  // A loss d from a story that had lost ref already, as a share of what it had.
+  static S share(S d, S ref) { return ref < S(1) ? d / (S(1) - ref) : d; }
 
   void run(S (&A)[N][N], const S* th, Test* t) const {
     t->valid = false;
