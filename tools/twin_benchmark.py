@@ -171,18 +171,8 @@ def prepare(args, tmp):
             records.append(cc.record_info(path, args.vines))
         except Exception as e:  # the package's RecordError names the file and the reason
             fail(f"{path}: unreadable record: {e}")
-    families = None
-    if args.only:
-        families = [f.strip() for f in args.only.split(",") if f.strip()]
-        for f in families:
-            if f not in FAMILIES:
-                fail(f"--only {f}: not a family ({', '.join(FAMILIES)})")
-    devices = None
-    if args.devices:
-        devices = [d.strip() for d in args.devices.split(",") if d.strip()]
-        for d in devices:
-            if d not in DEVICES:
-                fail(f"--devices {d}: not a device ({', '.join(DEVICES)})")
+    families = chosen(args.only, "--only", "family", FAMILIES)
+    devices = chosen(args.devices, "--devices", "device", DEVICES)
     args.bound = {"before": bound_shares(args.bound_located, "--bound-located"),
                   "before baseline": bound_shares(args.bound_located_baseline, "--bound-located-baseline")}
     todo = cc.cases(records, quick=args.quick, seed=args.design_seed, seeds=args.seeds, calibrate=args.calibrate,
@@ -211,6 +201,17 @@ def prepare(args, tmp):
     kept = {c.get("baseline") for c in todo}
     commission = [c for b in buildings if b["baseline"] in kept for c in b["commission"]]
     return records, todo, commission
+
+
+def chosen(text, flag, what, names):
+    """A comma-separated list of names (None without it); exits 2 on one that is not in names."""
+    if not text:
+        return None
+    out = [x.strip() for x in text.split(",") if x.strip()]
+    for x in out:
+        if x not in names:
+            fail(f"{flag} {x}: not a {what} ({', '.join(names)})")
+    return out
 
 
 def bound_shares(text, flag):
