@@ -183,10 +183,9 @@ TEST(TwinDecision, ChangeVerdictStandsAgainstTheAbsoluteTest) {
   // from the drawing and, once the onset has left the change scan's span,
   // is the stronger test. The verdict stays the change test's: 10 % of the
   // story's stiffness before, dated at the onset.
-  double base[N] = {}, sigma0[N][N] = {}, before[N] = {}, after[N], bias[N] = {};
+  double base[N] = {}, sigma0[N][N] = {}, before[N] = {}, after[N] = {}, bias[N] = {};
   for (int a = 0; a < N; ++a) sigma0[a][a] = 0.008 * 0.008;
   before[3] = 0.03;
-  for (int a = 0; a < N; ++a) after[a] = before[a];
   after[3] = 1 - (1 - before[3]) * 0.90;
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     Decision<double, N> d;

@@ -99,7 +99,6 @@ class Decision {
     }
     run(A, th, &abs_);
     abs_.onset_k = -1;
-    for (int a = 0; a < n_; ++a) abs_.ref[a] = base_[a];
   }
 
   // One part of the change scan, on the information so far (J, b): a
@@ -142,7 +141,7 @@ class Decision {
     Test cand;
     run(A, th, &cand);
     cand.onset_k = r.k;
-    for (int a = 0; a < n_; ++a) cand.ref[a] = before_[a];
+    for (int a = 0; a < n_; ++a) cand.before[a] = before_[a];
     if (cand.valid && cand.h.story >= 0 && (!scan_.valid || cand.h.one > scan_.h.one)) scan_ = cand;
     phase_ = 0, ++back_;
   }
@@ -187,11 +186,12 @@ class Decision {
     const Hypotheses<S, N>& h = best->h;
     // Sizes as shares of the stiffness the story had: of the window before
     // the onset's fit, or of the baseline's (the drawing's without one).
+    const S* ref = best->onset_k >= 0 ? best->before : base_;
     if (h.two - h.one > set_.two + set_.two_share * h.one) {
-      story_ = h.a, second_ = h.b, size_ = share(h.size_a, best->ref[h.a]), size2_ = share(h.size_b, best->ref[h.b]);
+      story_ = h.a, second_ = h.b, size_ = share(h.size_a, ref[h.a]), size2_ = share(h.size_b, ref[h.b]);
     } else {
       story_ = h.one - h.runner > set_.separation ? h.story : -1;
-      second_ = -1, size_ = share(h.size[h.story], best->ref[h.story]), size2_ = S(0);
+      second_ = -1, size_ = share(h.size[h.story], ref[h.story]), size2_ = S(0);
     }
     // The onset: a change test's candidate; for the absolute test, where the
     // score last rose, if it did within the snapshots' span, else where the
@@ -227,7 +227,7 @@ class Decision {
   struct Test {
     bool valid = false;
     long onset_k = -1;  // a change test's onset candidate (-1: the absolute test)
-    S ref[N] = {};      // the losses it measures the change from
+    S before[N] = {};   // a change test's: the losses of its window before the onset
     S row[N] = {};      // its best story's row of the precision
     Hypotheses<S, N> h;
   };
