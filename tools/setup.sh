@@ -32,6 +32,7 @@ rest=(
   mypy python3-pandas                            # its typing (mypy --strict), DataFrames
   python3-venv python3-pip                       # its `pip install .` test,
   python3-nbclient python3-ipykernel             # the notebook examples/paper.ipynb
+  python3-scipy                                  # the twin bound's VI NES part (matrix exponential)
   openmpi-bin libopenmpi-dev                     # vines sweep across MPI ranks
   clang libclang-rt-14-dev                       # libFuzzer target of the link decoder
   gcc-arm-none-eabi libnewlib-arm-none-eabi      # cortex-m4f, cortex-m7 presets

@@ -24,7 +24,7 @@ the failed runs, counted and listed. With --calibrate, undamaged runs only and t
 final loss estimate. Options the tool does not know go to `vines hil` (e.g. --twin-threshold).
 
 Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--quick] [--seeds N]
-                         [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES]
+                         [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES] [--only-records NAMES]
                          [--limit N] [--duration S] [--commission N | --baseline-dir DIR]
                          [--bound-located 5=P,10=P] [--bound-located-baseline 5=P,10=P]
                          [--calibrate] [--json FILE] [--sensors LIST] [--noise-pct P] [--plan]
@@ -135,6 +135,8 @@ def parse_args(argv=None):
     ap.add_argument("--design-seed", type=int, default=20261125, help="the design's seed: truths, onsets, assignment")
     ap.add_argument("--only", help="families, comma-separated: " + ", ".join(FAMILIES))
     ap.add_argument("--devices", help="devices, comma-separated: " + ", ".join(DEVICES))
+    ap.add_argument("--only-records", help="runs on these records only, comma-separated parts of their file names "
+                                           "(the same runs as the whole campaign's on them)")
     ap.add_argument("--limit", type=int, help="the first N runs, round-robin over the families")
     ap.add_argument("--duration", type=float, help="S seconds of every record instead of the Arias rule")
     ap.add_argument("--timeout", type=float, default=60, help="vines hil --timeout: longest wait for the node [s]")
@@ -196,6 +198,12 @@ def prepare(args, tmp):
                                      fail=fail) if not families or c["family"] in families]
     if devices:
         todo = [c for c in todo if c["device"] in devices]
+    if args.only_records:
+        parts = [x.strip() for x in args.only_records.split(",") if x.strip()]
+        for x in parts:
+            if not any(x in name for name in RECORDS):
+                fail(f"--only-records {x}: no record's file name holds it ({', '.join(RECORDS)})")
+        todo = [c for c in todo if any(x in os.path.basename(c["record"]) for x in parts)]
     if args.limit:
         todo = limited(todo, args.limit)
     kept = {c.get("baseline") for c in todo}

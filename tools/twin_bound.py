@@ -18,11 +18,16 @@ from it (docs/twin.md section 7):
   record (the part before an onset in the Arias 25-75 % span as the baseline), against a
   baseline from the other records, or without a baseline.
 Each record runs for max(--duration, its Arias 95 % time + 10 s), or to its end.
+With --device vines the frame carries the campaign's VI NES, its sphere starting at --sphere-x0:
+every impact's force is left unknown (tools/twin_bound_vines.py), and the noise is 5 % of each
+channel's RMS with the impacts' spikes in it, as the campaign draws it.
 
 Usage: twin_bound.py [--records DIR] [--sensors 3,6,8,10] [--noise-pct 5] [--mass-pct 2]
                      [--healthy-pct 3] [--duration 40] [--skip SUBSTRING ...] [--draws 400]
                      [--false-alarm 1] [--glrt-draws 300] [--onsets 5] [--node-json FILE] [--quick]
-Needs numpy and the vines Python package (build/release/python, or PYTHONPATH) to read records.
+                     [--device none|vines] [--sphere-x0 M]
+Needs numpy and the vines Python package (build/release/python, or PYTHONPATH) to read records;
+--device vines also scipy.
 """
 import argparse
 import os
@@ -32,6 +37,8 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import twin_bound_vines as tv  # noqa: E402
+import twin_campaign_cases as cc  # noqa: E402
 import twin_glrt as glrt  # noqa: E402
 from twin_benchmark import RECORDS, TABLE1_K_MN, TABLE1_MASS_T  # noqa: E402
 
@@ -51,36 +58,44 @@ def state_space(k, m, sensors):
     return A, b, C
 
 
-def outputs(k, m, ag, h, sensors):
+def outputs(k, m, ag, h, sensors, imp=None):
     """The sensors' outputs (state_space) from rest at t = 0, under the ground acceleration
-    ag sampled every h (held over each step): array (len(ag), len(sensors))."""
+    ag sampled every h (held over each step) and, with imp, a force on the top floor whose
+    impulse over step i is imp[i] (applied at the step's middle; the force's own share of the
+    top floor's acceleration at a sample is not in the outputs): array (len(ag), len(sensors))."""
     A, b, C = state_space(k, m, sensors)
     lam, V = np.linalg.eig(A)
-    b = np.linalg.solve(V, b)
+    n = len(m)
+    gain = (np.exp(lam * h) - 1) / lam * np.linalg.solve(V, b)
     cv = C @ V
-    # Each mode: z[i+1] = exp(lam h) z[i] + (exp(lam h) - 1) / lam b ag[i], by FFT convolution.
+    # Each mode: z[i+1] = exp(lam h) z[i] + gain ag[i] (+ its share of imp[i]), by FFT convolution.
     T = len(ag)
     L = 1 << int(np.ceil(np.log2(2 * T)))
     decay = np.exp(np.outer(lam * h, np.arange(T)))
-    gain = (np.exp(lam * h) - 1) / lam * b
-    z = np.fft.ifft(np.fft.fft(decay, L) * np.fft.fft(ag, L), L)[:, :T] * gain[:, None]
+    fd = np.fft.fft(decay, L)
+    z = np.fft.ifft(fd * np.fft.fft(ag, L), L)[:, :T] * gain[:, None]
+    if imp is not None:
+        top = np.zeros(2 * n)
+        top[2 * n - 1] = 1.0 / m[-1]
+        z += np.fft.ifft(fd * np.fft.fft(imp, L), L)[:, :T] * (np.exp(lam * h / 2) * np.linalg.solve(V, top))[:, None]
     z = np.hstack([np.zeros((len(lam), 1)), z[:, :-1]])
     return (cv @ z).real.T
 
 
-def jacobian(k, m, ag, h, sensors, noise_pct):
+def jacobian(k, m, ag, h, sensors, noise_pct, imp=None, sd=None):
     """The outputs' sensitivities to (log k, log m), each channel divided by its white noise's
-    sd (noise_pct % of its rms): array (2 n, samples, sensors); central differences of the
-    outputs (the model is linear in its state, smooth in its parameters)."""
-    y0 = outputs(k, m, ag, h, sensors)
-    sd = noise_pct / 100 * np.sqrt((y0 ** 2).mean(axis=0))
+    sd (noise_pct % of its rms, or sd given): array (2 n, samples, sensors); central differences
+    of the outputs (the model is linear in its state, smooth in its parameters)."""
+    if sd is None:
+        y0 = outputs(k, m, ag, h, sensors, imp)
+        sd = noise_pct / 100 * np.sqrt((y0 ** 2).mean(axis=0))
     n, step = len(k), 1e-5
     jac = []
     for j in range(2 * n):
         e = np.zeros(2 * n)
         e[j] = step
-        up = outputs(k * np.exp(e[:n]), m * np.exp(e[n:]), ag, h, sensors)
-        dn = outputs(k * np.exp(-e[:n]), m * np.exp(-e[n:]), ag, h, sensors)
+        up = outputs(k * np.exp(e[:n]), m * np.exp(e[n:]), ag, h, sensors, imp)
+        dn = outputs(k * np.exp(-e[:n]), m * np.exp(-e[n:]), ag, h, sensors, imp)
         jac.append((up - dn) / (2 * step) / sd)
     return np.array(jac)
 
@@ -137,6 +152,26 @@ def ideal_detector(covs, draws, seed=1):
     return best
 
 
+def information(vines, path, k, m, ag, h, sensors, args, cuts):
+    """The bare frame's Fisher information of (log k, log m) over the run, and over the samples
+    before each of cuts."""
+    jac = jacobian(k, m, ag, h, sensors, args.noise_pct)
+    return np.einsum("itc,jtc->ij", jac, jac), [np.einsum("itc,jtc->ij", jac[:, :i], jac[:, :i]) for i in cuts]
+
+
+def vines_information(vines, path, k, m, ag, h, sensors, args, cuts):
+    """The same for the campaign's VI NES building, every impact's force unknown
+    (twin_bound_vines.py); the run ends where the truth's does, if sooner."""
+    imp, kicked, touched, acc = tv.impacts(vines, cc.building("vines", path, x0=args.sphere_x0), h, len(ag) * h)
+    T = min(len(ag), len(imp))
+    rows = np.array(sensors) - 1
+    sd = args.noise_pct / 100 * np.sqrt((acc[:T, rows] ** 2).mean(axis=0))
+    jac = jacobian(k, m, ag[:T], h, sensors, args.noise_pct, imp=imp[:T], sd=sd)
+    A, _, C = state_space(k, m, sensors)
+    top = sensors.index(len(k)) if len(k) in sensors else None
+    return tv.information(jac, A, C, sd, kicked[:T], touched[:T], top, h, cuts)
+
+
 def run_length(rec, duration, h):
     """(ground acceleration every h over the run, Arias 25 % and 75 % times): the run lasts
     max(duration, the Arias 95 % time + 10 s), or to the record's end if that is sooner (the
@@ -166,6 +201,9 @@ def main():
     ap.add_argument("--node-json", help="a tools/twin_benchmark.py --json file: the node's size errors against "
                     "the bound's")
     ap.add_argument("--quick", action="store_true", help="fewer draws and onsets (a minute less, figures rougher)")
+    ap.add_argument("--device", choices=("none", "vines"), default="none",
+                    help="the frame bare, or with the campaign's VI NES and every impact's force unknown")
+    ap.add_argument("--sphere-x0", type=float, default=0.2, help="--device vines: the sphere's start [m]")
     args = ap.parse_args()
     if args.quick:
         args.draws, args.glrt_draws, args.onsets = 100, 60, 2
@@ -181,6 +219,8 @@ def main():
                         ("--glrt-draws", args.glrt_draws, 0), ("--onsets", args.onsets, 0)):
         if not (np.isfinite(v) and v > lo):
             sys.exit(f"twin_bound.py: error: {name} {v}: must be a positive number")
+    if args.device == "vines" and not (np.isfinite(args.sphere_x0) and abs(args.sphere_x0) < cc.GAP_M):
+        sys.exit(f"twin_bound.py: error: --sphere-x0 {args.sphere_x0}: within the box's +-{cc.GAP_M} m")
     if args.false_alarm >= 100:
         sys.exit(f"twin_bound.py: error: --false-alarm {args.false_alarm}: a percentage under 100")
     nodes = None
@@ -201,7 +241,9 @@ def main():
     m = np.array(TABLE1_MASS_T) * 1e3
     h = 1.0 / args.rate
     mass_sd = args.mass_pct / 100 / np.sqrt(3)
-    print(f"twin bound: bare Table 1 frame, floors {args.sensors} at {args.rate:g} Hz, noise {args.noise_pct:g} % rms, "
+    frame = "bare Table 1 frame" if args.device == "none" else \
+        f"Table 1 frame with the campaign's VI NES (sphere from {args.sphere_x0:g} m, every impact unknown)"
+    print(f"twin bound: {frame}, floors {args.sensors} at {args.rate:g} Hz, noise {args.noise_pct:g} % rms, "
           f"masses within +-{args.mass_pct:g} %, each record for max({args.duration:g} s, Arias 95 % + 10 s) "
           "or to its end")
     print("record | run s | sd, masses known (largest) | Bayesian bound, masses unknown (median / largest) "
@@ -216,14 +258,11 @@ def main():
         except Exception as e:  # the package's RecordError names the file and the reason
             sys.exit(f"twin_bound.py: error: {e}")
         ag, t25, t75 = run_length(rec, args.duration, h)
-        jac = jacobian(k, m, ag, h, sensors, args.noise_pct)
-        F = np.einsum("itc,jtc->ij", jac, jac)
-        parts = []
-        for q in (np.arange(args.onsets) + 0.5) / args.onsets:  # onsets spread evenly over the span
-            i0 = int(round((t25 + q * (t75 - t25)) / h))
-            before = np.einsum("itc,jtc->ij", jac[:, :i0], jac[:, :i0])
-            parts.append((before, F - before))
-        del jac
+        cuts = [int(round((t25 + q * (t75 - t25)) / h))  # onsets spread evenly over the span
+                for q in (np.arange(args.onsets) + 0.5) / args.onsets]
+        F, befores = (information if args.device == "none" else vines_information)(
+            vines, path, k, m, ag, h, sensors, args, cuts)
+        parts = [(before, F - before) for before in befores]
         info[name] = (F, parts)
         known, cov, bias = bounds(F, mass_sd)
         bayes = np.sqrt(np.diag(cov))
