@@ -24,8 +24,8 @@ the failed runs, counted and listed. With --calibrate, undamaged runs only and t
 final loss estimate. Options the tool does not know go to `vines hil` (e.g. --twin-threshold).
 
 Usage: twin_benchmark.py [--vines PATH] [--records DIR] [--jobs N] [--quick] [--seeds N]
-                         [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES] [--only-records NAMES]
-                         [--limit N] [--duration S] [--commission N | --baseline-dir DIR]
+                         [--undamaged N] [--replicates N] [--design-seed S] [--only FAMILIES]
+                         [--only-records NAMES] [--limit N] [--duration S] [--commission N | --baseline-dir DIR]
                          [--bound-located 5=P,10=P] [--bound-located-baseline 5=P,10=P]
                          [--calibrate] [--json FILE] [--sensors LIST] [--noise-pct P] [--plan]
 Exit 2 with a message naming the input on a missing program, folder, record or baseline file.

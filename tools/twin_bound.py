@@ -152,9 +152,9 @@ def ideal_detector(covs, draws, seed=1):
     return best
 
 
-def information(vines, path, k, m, ag, h, sensors, args, cuts):
+def bare_information(vines, path, k, m, ag, h, sensors, args, cuts):
     """The bare frame's Fisher information of (log k, log m) over the run, and over the samples
-    before each of cuts."""
+    before each of cuts (vines and path unused: vines_information's signature)."""
     jac = jacobian(k, m, ag, h, sensors, args.noise_pct)
     return np.einsum("itc,jtc->ij", jac, jac), [np.einsum("itc,jtc->ij", jac[:, :i], jac[:, :i]) for i in cuts]
 
@@ -260,7 +260,7 @@ def main():
         ag, t25, t75 = run_length(rec, args.duration, h)
         cuts = [int(round((t25 + q * (t75 - t25)) / h))  # onsets spread evenly over the span
                 for q in (np.arange(args.onsets) + 0.5) / args.onsets]
-        F, befores = (information if args.device == "none" else vines_information)(
+        F, befores = (bare_information if args.device == "none" else vines_information)(
             vines, path, k, m, ag, h, sensors, args, cuts)
         parts = [(before, F - before) for before in befores]
         info[name] = (F, parts)

@@ -14,13 +14,14 @@ The impacts are the truth's own (`vines.run` of the campaign's VI NES building w
 --sphere-x0, at 4 sensor samples a period to see each contact). The information of the stiffness
 and mass factors left once every kick is eliminated is the Gauss-Markov estimate's with the kicks
 as free parameters: the sensitivities whitened by a Kalman filter whose kick variance is
-unbounded (1e4 times each kick's unit effect: the limit to about 1e-8) at the kick
-periods, and zero elsewhere (the frame's state is otherwise known from rest).
+unbounded at the kick periods (the three directions made orthonormal in their outputs, each of
+prior sd 1e4: the limit within about 1e-8, tests/twin_bound_test.py), and zero elsewhere (the
+frame's state is otherwise known from rest).
 """
 import numpy as np
 
 OVERSAMPLE = 4  # the truth's run samples each sensor period this many times
-KICK_SD = 1e4   # each kick direction's prior sd, in units of its own output's norm (unbounded)
+KICK_SD = 1e4   # each kick direction's prior sd, its outputs orthonormal (unbounded)
 
 
 def impacts(vines, tables, h, duration):
@@ -79,7 +80,8 @@ def information(jac, A, C, sd, kicked, touched, top, h, cuts=()):
         O.append(Cw @ X)
         X = Phi @ X
     _, sv, vt = np.linalg.svd(np.vstack(O), full_matrices=False)
-    G = G @ vt.T[:, sv > 1e-12 * sv[0]] / sv[sv > 1e-12 * sv[0]]
+    seen = sv > 1e-12 * sv[0]
+    G = G @ vt.T[:, seen] / sv[seen]
     Q = KICK_SD ** 2 * G @ G.T
     keep_all, keep_top = np.arange(ny), np.array([i for i in range(ny) if i != top])
     xs = np.zeros((nx, npar))   # the filter's estimate of each sensitivity's state
