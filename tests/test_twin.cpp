@@ -221,11 +221,12 @@ TEST(Twin, DetunedTmdReported) {
 
 // The estimator in float (the Cortex-M4F's) on the same image and readings
 // as in double: the roof within 1e-3 of the double's peak, every factor
-// within 0.005, the same decision.
+// within 0.005, the same decision. 30 s: on 20 s of this record the
+// double's alarm is not sure to come (seeds 1-4 raise it at 9-20 s of 30).
 TEST(Twin, FloatFollowsDouble) {
   Scene sc = load_scene(scene_path("elcentro_vines.toml"));
-  sc.duration_s = 20;
-  HilOptions o = twin(20.0, "twin/truth_story3_loss10.toml");
+  sc.duration_s = 30;
+  HilOptions o = twin(30.0, "twin/truth_story3_loss10.toml");
   const Excitation ex = load_excitation(sc, "");
   const TwinBench tb = make_twin_bench(sc, o, ex);
   auto f = std::make_unique<twin::Estimator<float, 10>>();

@@ -18,9 +18,9 @@ namespace vines::host {
 // docs/twin.md section 4.
 struct TwinTuning {
   double model_accel_sd = 0.05;  // process noise: floor accelerations the model misses [m/s^2, white over a period]
-  double force_sd_mps2 = 2.0;    // VI NES force on its floor / floor mass: stationary sd [m/s^2]...
+  double force_sd_mps2 = 500;    // VI NES force on its floor / floor mass: stationary sd [m/s^2]...
   double force_tau_s = 0.02;     // ...and correlation time
-  double quiet_force_share = 0.05;  // the force's sd between impacts, a share of force_sd
+  double quiet_force_share = 1e-4;  // the force's sd between impacts, a share of force_sd
   double jump_sigma = 5;         // an innovation beyond this many sd switches to the impact gain...
   double jump_hold_s = 0.01;     // ...for this long
   double memory_s = 30;          // the losses' information forgets with this time constant

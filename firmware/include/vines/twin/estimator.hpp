@@ -42,7 +42,7 @@ class Estimator : public ImageDecoder<S, N> {
       bc_[j] = S(0);
     }
     for (S& v : Jc_) v = S(0);
-    for (int i = 0; i < kY; ++i) r2_[i] = var_[i], eps_[i] = S(0);
+    for (int i = 0; i < kY; ++i) r2_[i] = q2_[i] = var_[i], eps_[i] = S(0);
     since_ = 0, k_ = 0, phase_ = 0, score_ = S(0), misfit_ = S(0);
     lam_update_ = static_cast<S>(std::pow(set_[kForget], static_cast<double>(update_steps_)));
     for (int a = 0; a < kP; ++a) {
@@ -163,8 +163,13 @@ class Estimator : public ImageDecoder<S, N> {
         psi[i][j] = dot(C_[i], s_[j], nx) + H_[i][j] * wz[j];
       }
       eps_[i] = static_cast<S>(y[i]) - yh;
-      impact = impact || eps_[i] * eps_[i] > jump * jump * var_[i];
+      impact = impact || eps_[i] * eps_[i] > jump * jump * (q2_[i] > var_[i] ? q2_[i] : var_[i]);
     }
+    // The level a jump is measured against: the quiet samples' running mean
+    // square, never below the design's; a model that is off (a sphere stuck
+    // on its floor) raises it, an impact does not.
+    if (!impact)
+      for (int i = 0; i < ny; ++i) q2_[i] += static_cast<S>(set_[kInnovAlpha]) * (eps_[i] * eps_[i] - q2_[i]);
     // The gain: the quiet one (the device's force held near zero) unless an
     // innovation jumps beyond kJumpSigma of its quiet sd, then the impact
     // one (the force free) for kJumpHold steps.
@@ -362,7 +367,7 @@ class Estimator : public ImageDecoder<S, N> {
   S z_[kX] = {}, s_[kP][kX] = {}, a_ = S(0);
   S J_[kP][kP] = {}, g_[kP] = {}, loss_[kP] = {}, sd_[kP] = {};
   S Jc_[Decision<S, N>::kTri] = {}, bc_[kP] = {};  // the change tests' information since the start
-  S r2_[kY] = {}, eps_[kY] = {};
+  S r2_[kY] = {}, q2_[kY] = {}, eps_[kY] = {};
   long held_[kP] = {};
   long since_ = 0, impact_left_ = 0, k_ = 0, calm_ = 0;
   bool device_alarm_ = false, factored_ = false;
