@@ -15,6 +15,7 @@
 
 #include "sim_host/hil/hil.hpp"
 #include "sim_host/hil/modes/twin_baseline.hpp"
+#include "sim_host/hil/modes/twin_design.hpp"
 
 namespace vines::host {
 namespace {
@@ -52,6 +53,18 @@ std::string thrown(F f) {
 
 std::string refusal(const std::string& path, const TwinBuilding& b) {
   return thrown([&] { load_twin_baseline(path, b, TwinTuning{}); });
+}
+
+TEST(TwinDesign, ChiSquareQuantile) {
+  // scipy.stats.chi2.isf(0.001, k) and isf(0.05, k)
+  EXPECT_NEAR(chi_square_quantile(1, 0.001), 10.827566, 1e-5);
+  EXPECT_NEAR(chi_square_quantile(2, 0.001), 13.815511, 1e-5);
+  EXPECT_NEAR(chi_square_quantile(9, 0.001), 27.877165, 1e-5);
+  EXPECT_NEAR(chi_square_quantile(10, 0.001), 29.588298, 1e-5);
+  EXPECT_NEAR(chi_square_quantile(9, 0.05), 16.918978, 1e-5);
+  EXPECT_EQ(chi_square_quantile(0, 0.001), 0.0);
+  EXPECT_THROW(chi_square_quantile(9, 1.0), std::runtime_error);
+  EXPECT_THROW(chi_square_quantile(9, 0.0), std::runtime_error);
 }
 
 TEST(TwinBaseline, StatisticsOfTheRuns) {

@@ -132,6 +132,7 @@ DecisionSettings<double> settings() {
   s.threshold = 25, s.threshold_change = 36, s.two = 10.8, s.separation = 4, s.inflation = 1, s.drift_var = 1e-6;
   s.snap_steps = 20;  // one a second at 20 updates a second
   s.hold_steps = 40;  // 2 s
+  s.fit_gate = 27.877;  // chi-square, 9 degrees of freedom, 0.1 % (scipy.stats.chi2.isf(0.001, 9))
   return s;
 }
 
@@ -235,6 +236,24 @@ TEST(TwinDecision, LossBeforeTheRecordFoundAgainstTheBaseline) {
   ASSERT_TRUE(d.detected());
   EXPECT_EQ(d.story(), 8);
   EXPECT_NEAR(d.size(), 0.05, 0.01);
+}
+
+TEST(TwinDecision, EstimateNoHypothesisExplainsRaisesNoAlarm) {
+  // The estimates err in alternating signs by 8 % where their covariance
+  // claims 0.5 % (a record the model does not explain): the best story's
+  // statistic is far beyond the threshold, and what it leaves unexplained
+  // far beyond the chi-square gate. With the gate, no alarm; without it,
+  // one. A single 5 % loss passes it (LossBeforeTheRecordFoundAgainstTheBaseline).
+  double base[N] = {}, sigma0[N][N] = {}, before[N], bias[N] = {};
+  for (int a = 0; a < N; ++a) before[a] = a % 2 ? 0.08 : -0.08, sigma0[a][a] = 0.005 * 0.005;
+  for (double gate : {27.877, 1e30}) {
+    DecisionSettings<double> s = settings();
+    s.fit_gate = gate;
+    Decision<double, N> d;
+    d.init(N, N, s, base, sigma0, kPrior);
+    Synthetic{}.run(&d, before, before, bias, 1e9, 40.0, 5);
+    EXPECT_EQ(d.detected(), gate > 1e6) << gate;
+  }
 }
 
 TEST(TwinDecision, MisfitWidensTheAbsoluteTest) {

@@ -362,6 +362,8 @@ void add_hil(CLI::App& vines) {
       {"--twin-misfit-level", {&tu.misfit_level, "the change score per parameter of a model that holds; beyond "
                                                  "it, the absolute test's estimate covariance times the excess..."}},
       {"--twin-misfit-memory", {&tu.misfit_memory_s, "...held this long [s]"}},
+      {"--twin-fit-tail", {&tu.fit_tail, "the absolute test's best hypothesis leaves unexplained at most the "
+                                         "chi-square quantile of this tail (below 1)"}},
       {"--twin-suspect", {&tu.suspect, "the change score beyond this restarts the losses' information..."}},
       {"--twin-restart-gap", {&tu.restart_gap_s, "...at most once in this long [s]..."}},
       {"--twin-restart-keep", {&tu.restart_keep, "...keeping this share of it"}},

@@ -164,6 +164,31 @@ Mat riccati(const Mat& A, const Mat& Cm, const Mat& Q, const Mat& R) {
 
 }  // namespace
 
+// By bisection on the survival function, exact for whole k (y = x / 2):
+// e^-y sum_i<m y^i / i! (k = 2m); erfc(sqrt y) + e^-y sum_i<m y^(i+1/2) /
+// Gamma(i + 3/2) (k = 2m + 1).
+double chi_square_quantile(int k, double tail) {
+  if (!(tail > 0 && tail < 1)) throw std::runtime_error("--twin-fit-tail: a tail probability, above 0 and below 1");
+  if (k < 1) return 0;
+  auto survival = [k](double x) {
+    const double y = x / 2;
+    double sum = 0, term = 1;
+    if (k % 2 == 0) {
+      for (int i = 0; i < k / 2; ++i) sum += term, term *= y / (i + 1);
+      return std::exp(-y) * sum;
+    }
+    term = std::sqrt(y) / (std::sqrt(M_PI) * 0.5);
+    for (int i = 0; i < k / 2; ++i) sum += term, term *= y / (i + 1.5);
+    return std::erfc(std::sqrt(y)) + std::exp(-y) * sum;
+  };
+  double lo = 0, hi = 10.0 * k + 200;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (survival(mid) > tail ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::vector<int>& sensors,
                        const std::vector<double>& noise_sd, const TwinTuning& t, const TwinBaselineStats* baseline) {
   const int ny = static_cast<int>(sensors.size());
@@ -230,6 +255,7 @@ TwinDesign design_twin(const SceneParams& p, const ModelInfo& info, const std::v
   set[twin::kCalmSteps] = std::round(t.calm_s / h);
   set[twin::kMisfitLevel] = t.misfit_level;
   set[twin::kMisfitForget] = std::exp(-set[twin::kUpdateSteps] * h / t.misfit_memory_s);
+  set[twin::kFitGate] = chi_square_quantile(d.stories - 1, t.fit_tail);
   set[twin::kBeforeVarMax] = t.before_sd_max * t.before_sd_max;
   set[twin::kDeviceLossMin] = t.device_loss_min;
   set[twin::kHoldSteps] = std::round(t.hold_s / h);

@@ -49,6 +49,8 @@ struct TwinTuning {
   double score_window_s = 2;     // the score's memory
   double misfit_level = 3;       // the score per parameter of a model that holds (section 5)...
   double misfit_memory_s = 10;   // ...beyond it, held this long, the absolute test's estimate covariance times it
+  double fit_tail = 0.001;       // the absolute test's hypotheses explain the estimate: what the best leaves within
+                                 // the chi-square quantile (stories - 1 degrees of freedom) of this tail
   double suspect = 60;           // the score statistic beyond this restarts the information...
   double restart_gap_s = 10;     // ...at most once in this long...
   double restart_keep = 0.3;     // ...keeping this share of it
@@ -74,6 +76,10 @@ struct TwinDesign {
   std::vector<double> innovation_sd;  // steady-state innovation sd per sensor [m/s^2]
   double roof_sd_m = 0;               // steady-state posterior sd of the roof displacement [m]
 };
+
+// The chi-square distribution's quantile of upper tail `tail` (0 < tail < 1,
+// else throws) for k degrees of freedom; 0 for k < 1.
+double chi_square_quantile(int k, double tail);
 
 // sensors: 1-based floors; noise_sd: each sensor's noise [m/s^2 RMS];
 // info: the nominal scene's built model (device design). Throws

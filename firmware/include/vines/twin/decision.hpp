@@ -48,6 +48,7 @@ struct DecisionSettings {
   long hold_steps = 0;        // a candidate held this long raises the alarm
   long restart_steps = 0;     // the estimator restarts at most once in this many steps
   S before_var_max = S(1);    // a candidate onset: every story's fit before it within this variance
+  S fit_gate = S(1e30);       // the absolute test: the best hypothesis leaves at most this (and two_share of it) unexplained
 };
 
 // A symmetric matrix of the parameters (the stories and the device's), its
@@ -99,6 +100,13 @@ class Decision {
     }
     run(A, th, &abs_);
     abs_.onset_k = -1;
+    // The hypotheses must explain the estimate: what the best of them leaves
+    // (chi-square with n - 1 degrees of freedom while one holds) beyond the
+    // gate says none does (a record the model does not explain, whose
+    // estimates err in a pattern no loss makes): no candidate.
+    const Hypotheses<S, N>& h = abs_.h;
+    const S best = h.two > h.one ? h.two : h.one;
+    if (abs_.valid && h.total - best > set_.fit_gate + set_.two_share * best) abs_.valid = false;
   }
 
   // One part of the change scan, on the information so far (J, b): a

@@ -360,6 +360,7 @@ class Estimator : public ImageDecoder<S, N> {
     c.hold_steps = hold_steps_;
     c.restart_steps = static_cast<long>(set_[kRestartSteps]);
     c.before_var_max = static_cast<S>(set_[kBeforeVarMax]);
+    c.fit_gate = static_cast<S>(set_[kFitGate]);
     return c;
   }
 

@@ -78,6 +78,7 @@ struct Hypotheses {
   int a = -1, b = -1;  // the best pair (both losses)...
   S two = S(0);        // ...its statistic
   S size_a = S(0), size_b = S(0);
+  S total = S(0);      // theta' P theta: the statistic of every story free
 };
 
 // One story j: u = P theta, statistic u_j^2 / P_jj, size u_j / P_jj. Two
@@ -93,6 +94,7 @@ void test_hypotheses(const S (&P)[N][N], const S* theta, int n, Hypotheses<S, N>
     u[a] = t;
   }
   *h = Hypotheses<S, N>{};
+  for (int a = 0; a < n; ++a) h->total += u[a] * theta[a];
   for (int j = 0; j < n; ++j) {
     h->size[j] = u[j] / P[j][j];
     h->stat[j] = u[j] > S(0) ? u[j] * h->size[j] : S(0);

@@ -34,7 +34,7 @@ inline constexpr int kMaxSensors = 8;
 inline constexpr std::uint8_t kNone8 = 255;  // "no device DOF"
 
 inline constexpr std::uint8_t kTwinMagic[4] = {'V', 'N', 'T', 'W'};
-inline constexpr std::uint16_t kTwinVersion = 5;
+inline constexpr std::uint16_t kTwinVersion = 6;
 
 // The state beyond the frame's 2N: none (bare frame), the device's force on
 // its floor as an unknown input (VI NES: one state), or the TMD's own mass
@@ -78,6 +78,7 @@ enum TwinSetting : int {
   kTwoShare,      // two stories: ...and beyond the best story's by this share of it
   kMisfitLevel,   // the score per parameter of a model that holds: beyond it, the misfit...
   kMisfitForget,  // ...held with this memory per update, scales the absolute test's estimate covariance
+  kFitGate,       // the absolute test: what the best hypothesis leaves unexplained at most (chi-square)
   kTwinSettings
 };
 

@@ -146,7 +146,8 @@ class ImageDecoder {
         !(c[kSnapSteps] >= 1 && c[kSnapSteps] <= 1e6) || !(c[kSuspect] > 0) || !(c[kRestartSteps] >= 0) ||
         !(c[kRestartKeep] > 0 && c[kRestartKeep] <= 1) || !(c[kScoreForget] >= 0 && c[kScoreForget] < 1) ||
         !(c[kCalmSteps] >= 0 && c[kCalmSteps] <= 1e6) || !(c[kBeforeVarMax] > 0) ||
-        !(c[kTwoShare] >= 0) || !(c[kMisfitLevel] > 0) || !(c[kMisfitForget] >= 0 && c[kMisfitForget] < 1))
+        !(c[kTwoShare] >= 0) || !(c[kMisfitLevel] > 0) || !(c[kMisfitForget] >= 0 && c[kMisfitForget] < 1) ||
+        !(c[kFitGate] >= 0))
       return "twin image: a setting out of range";
     // The model's covariance: symmetric with a positive diagonal (the tests
     // add it to a positive definite one).
